@@ -1,0 +1,45 @@
+"""Collision-distance models behind one interface: coal ground truth and learned estimators.
+
+Every model maps a scene and a batch of configurations q (B, dof) to distances d (B,) in metres
+(positive = free) and, with ``distance_and_grad``, to ∂d/∂q (B, dof), float64 at the API.
+Planners, the CasADi bridge and the evaluation take any :class:`DistanceModel`.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from ..distance import signed_distance, signed_distance_and_grad
+from ..scene import Scene
+
+
+@runtime_checkable
+class DistanceModel(Protocol):
+    """What every collision-distance model provides."""
+
+    name: str
+
+    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        """(B,) distances (m) of configurations q (B, dof) or (dof,)."""
+        ...
+
+    def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """((B,), (B, dof)) distances and their gradients with respect to q."""
+        ...
+
+
+class CoalModel:
+    """Exact signed distance from coal (the ground truth) as a :class:`DistanceModel`."""
+
+    name = "coal"
+
+    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        return signed_distance(scene, q)
+
+    def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return signed_distance_and_grad(scene, q)
+
+
+__all__ = ["CoalModel", "DistanceModel"]
