@@ -76,7 +76,6 @@ class CoalChecker:
         self.identity = coal.Transform3s()
         self.request = coal.DistanceRequest()
         self.request.enable_signed_distance = True
-        self.request.enable_nearest_points = True
         self.result = coal.DistanceResult()
         self.functors = [
             [coal.ComputeDistance(ls, ps) for ps in self.part_shapes] for ls in self.link_shapes
