@@ -92,7 +92,9 @@ class CoalChecker:
         return gap - self.link_radius[None, :, None] - self.part_radius[None, None, :]
 
     # ------------------------------------------------------------------ narrow phase
-    def _pair(self, link: int, part: int, tf: coal.Transform3s) -> tuple[float, np.ndarray, np.ndarray]:
+    def _pair(
+        self, link: int, part: int, tf: coal.Transform3s
+    ) -> tuple[float, np.ndarray, np.ndarray]:
         res = self.result
         res.clear()
         self.functors[link][part](tf, self.identity, self.request, res)
@@ -121,9 +123,11 @@ class CoalChecker:
         dist = np.full(shape, cap, dtype=float)
         point = np.zeros((*shape, 2))
         normal = np.zeros((*shape, 2))
-        link = np.zeros(shape, dtype=int) if not per_link else np.broadcast_to(
-            np.arange(n_links), shape
-        ).copy()
+        link = (
+            np.zeros(shape, dtype=int)
+            if not per_link
+            else np.broadcast_to(np.arange(n_links), shape).copy()
+        )
         for b in range(len(q)):
             tfs = self._transforms(poses[b])
             if per_link:

@@ -181,7 +181,9 @@ class Robot:
     def chain(self) -> PlanarChain:
         data = self.model.createData()
         pin.forwardKinematics(self.model, data, np.zeros(self.dof))
-        origins = np.array([self.plane.project(data.oMi[j].translation) for j in range(1, self.dof + 1)])
+        origins = np.array(
+            [self.plane.project(data.oMi[j].translation) for j in range(1, self.dof + 1)]
+        )
         signs = []
         for j in range(1, self.dof + 1):
             axis = data.oMi[j].rotation @ _joint_axis(self.model, j)
@@ -352,7 +354,7 @@ def geometry_points(geometry, samples: int = 24) -> np.ndarray:
         r, h = geometry.radius, geometry.halfLength
         pts = [ring * r + [0, 0, z] for z in (-h, h)]
         if isinstance(geometry, coal.Capsule):
-            pts += [_sphere_points(r, ang) + [0, 0, z] for z in (-h, h)]
+            pts += [_sphere_points(r, ang) + np.array([0.0, 0.0, z]) for z in (-h, h)]
         return np.concatenate(pts)
     if hasattr(geometry, "vertices"):  # BVH meshes and convex hulls
         return np.asarray(geometry.vertices())
@@ -414,9 +416,7 @@ def robot_from_urdf(
     for jname in spec.planning_joints:
         if not model.existJointName(jname):
             raise UnknownNameError(f"planning joint {jname!r} is not in {spec.urdf.name}")
-    lock_ids = [
-        j for j in range(1, model.njoints) if model.names[j] not in spec.planning_joints
-    ]
+    lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in spec.planning_joints]
     reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
     for j in range(1, reduced.njoints):
         if reduced.parents[j] != j - 1 or reduced.joints[j].nq != 1:
@@ -471,7 +471,9 @@ def _attach(model, data, plane: Plane, name: str, frame: int, uv: np.ndarray) ->
     """A polygon given at q = 0 in plane coordinates, attached to a frame."""
     joint = model.frames[frame].parentJoint
     local = apply_se3(data.oMf[frame].inverse(), plane.lift(uv))
-    return LinkPolygon(name=name, body=int(joint), frame=int(frame), vertices0=uv, vertices_frame=local)
+    return LinkPolygon(
+        name=name, body=int(joint), frame=int(frame), vertices0=uv, vertices_frame=local
+    )
 
 
 # -------------------------------------------------------------------- registry

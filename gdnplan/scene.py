@@ -139,7 +139,9 @@ def env_b(seed: int = 0) -> Scene:
 
 def _squares(robot: Robot, seed: int, n: int = 20) -> list[np.ndarray]:
     rng = np.random.default_rng(seed)
-    return _place(lambda g: square(g.uniform(-2, 2, 2), 0.2, g.uniform(0, np.pi / 2)), n, robot, rng)
+    return _place(
+        lambda g: square(g.uniform(-2, 2, 2), 0.2, g.uniform(0, np.pi / 2)), n, robot, rng
+    )
 
 
 @register_scene("c")

@@ -6,6 +6,7 @@ Run from the repository root: ``python robots/make_planar_urdf.py``.
 from pathlib import Path
 
 WIDTH = 0.06  # m, link width in the plane
+PI = 3.141592653589793
 HEIGHT = 1.0  # m, out-of-plane thickness (irrelevant to the 2-D polygons)
 
 
@@ -17,7 +18,7 @@ def planar_urdf(name: str, lengths: list[float]) -> str:
             f'  <joint name="joint{i}" type="revolute">',
             f'    <parent link="{parent}"/><child link="link{i}"/>',
             f'    <origin xyz="{offset} 0 0"/><axis xyz="0 0 1"/>',
-            '    <limit lower="-3.141592653589793" upper="3.141592653589793" effort="10" velocity="2"/>',
+            f'    <limit lower="{-PI}" upper="{PI}" effort="10" velocity="2"/>',
             "  </joint>",
             f'  <link name="link{i}">',
             "    <collision>",

@@ -58,13 +58,15 @@ def test_axis_aligned_overlap_depth_is_analytic():
 def test_gradient_matches_central_differences(env):
     scene = gp.make_scene(env, seed=5)
     q = scene.robot.sample(200, seed=8)
-    d, g = gp.signed_distance_and_grad(scene, q)
+    _, g = gp.signed_distance_and_grad(scene, q)
     eps = 1e-6
     fd = np.empty_like(g)
     for j in range(scene.robot.dof):
         dq = np.zeros(scene.robot.dof)
         dq[j] = eps
-        fd[:, j] = (gp.signed_distance(scene, q + dq) - gp.signed_distance(scene, q - dq)) / (2 * eps)
+        fd[:, j] = (gp.signed_distance(scene, q + dq) - gp.signed_distance(scene, q - dq)) / (
+            2 * eps
+        )
     rel = np.linalg.norm(g - fd, axis=1) / np.maximum(np.linalg.norm(fd, axis=1), 1e-12)
     assert np.mean(rel < 1e-4) >= 0.95, np.sort(rel)[-10:]
 
@@ -73,7 +75,7 @@ def test_per_link_distance_and_gradient():
     scene = gp.make_scene("d", seed=2)
     q = scene.robot.sample(300, seed=1)
     d_links, g_links = gp.signed_distance_and_grad(scene, q, per_link=True)
-    d, g = gp.signed_distance_and_grad(scene, q)
+    d, _ = gp.signed_distance_and_grad(scene, q)
     assert d_links.shape == (300, 7) and g_links.shape == (300, 7, 7)
     np.testing.assert_allclose(d_links.min(1), d, atol=1e-12)
     # a link's distance never depends on joints downstream of it
@@ -82,7 +84,10 @@ def test_per_link_distance_and_gradient():
     eps = 1e-6
     dq = np.zeros(7)
     dq[2] = eps
-    fd = (gp.signed_distance(scene, q + dq, per_link=True) - gp.signed_distance(scene, q - dq, per_link=True)) / (2 * eps)
+    fd = (
+        gp.signed_distance(scene, q + dq, per_link=True)
+        - gp.signed_distance(scene, q - dq, per_link=True)
+    ) / (2 * eps)
     close = np.abs(g_links[..., 2] - fd) < 1e-5
     assert close.mean() > 0.97
 

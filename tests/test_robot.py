@@ -9,8 +9,12 @@ from gdnplan.robot import as_batch
 def test_planar_chain_equals_pinocchio(name):
     robot = gp.load_robot(name)
     q = robot.sample(20, seed=1)
-    np.testing.assert_allclose(robot.node_positions(q), robot.node_positions_pinocchio(q), atol=1e-12)
-    np.testing.assert_allclose(robot.node_jacobians(q), robot.node_jacobians_pinocchio(q), atol=1e-12)
+    np.testing.assert_allclose(
+        robot.node_positions(q), robot.node_positions_pinocchio(q), atol=1e-12
+    )
+    np.testing.assert_allclose(
+        robot.node_jacobians(q), robot.node_jacobians_pinocchio(q), atol=1e-12
+    )
 
 
 @pytest.mark.parametrize("name", ["planar2", "planar7"])

@@ -32,7 +32,9 @@ def test_generators_are_seeded(env):
 
 def test_random_environments_change_with_seed_fixed_ones_do_not():
     for env, fixed in [("a", True), ("b", False), ("c", True), ("d", False), ("e", False)]:
-        same = np.array_equal(gp.make_scene(env, seed=1).obstacles[0], gp.make_scene(env, seed=2).obstacles[0])
+        same = np.array_equal(
+            gp.make_scene(env, seed=1).obstacles[0], gp.make_scene(env, seed=2).obstacles[0]
+        )
         assert same == fixed, env
 
 
@@ -68,9 +70,21 @@ def test_scene_from_config_combines_generator_and_polygons():
         ({"robot": {"name": "planar9"}}, gp.UnknownNameError, "robot"),
         ({"robot": {"name": "planar2"}, "scene": {"generator": "z"}}, gp.UnknownNameError, "scene"),
         ({"scene": {}}, gp.ProblemFileError, "robot"),
-        ({"robot": {"name": "planar2"}, "obstacles": [{"poly": []}]}, gp.ProblemFileError, "polygon"),
-        ({"robot": {"name": "planar2"}, "obstacles": [{"polygon": [[0, 0], [1, 0]]}]}, gp.ProblemFileError, "obstacles"),
-        ({"robot": {"name": "planar2"}, "scene": {"generator": "d", "seed": "x"}}, gp.ProblemFileError, "seed"),
+        (
+            {"robot": {"name": "planar2"}, "obstacles": [{"poly": []}]},
+            gp.ProblemFileError,
+            "polygon",
+        ),
+        (
+            {"robot": {"name": "planar2"}, "obstacles": [{"polygon": [[0, 0], [1, 0]]}]},
+            gp.ProblemFileError,
+            "obstacles",
+        ),
+        (
+            {"robot": {"name": "planar2"}, "scene": {"generator": "d", "seed": "x"}},
+            gp.ProblemFileError,
+            "seed",
+        ),
     ],
 )
 def test_bad_scene_config_names_the_field(cfg, error, field):
