@@ -19,8 +19,11 @@ lower bound |c_k − c_p| − r_k − r_p cannot beat the best distance found so
 
 from __future__ import annotations
 
+import os
 import weakref
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from multiprocessing import get_context
 
 import coal
 import numpy as np
@@ -29,6 +32,7 @@ from .robot import cross_z
 from .scene import Scene
 
 PRISM_HALF_HEIGHT = 1.0  # m
+PARALLEL_MIN_BATCH = 2000  # batches at least this large are split over all cores
 
 
 def _prism(poly: np.ndarray) -> coal.ConvexBase:
@@ -178,13 +182,40 @@ def witness_gradient(scene: Scene, q: np.ndarray, w: Witness) -> np.ndarray:
     return -np.einsum("...i,...ji->...j", w.normal, velocity) * upstream
 
 
+_FORKED_SCENE: Scene | None = None  # the scene forked workers read (set just before forking)
+
+
+def _closest_in_worker(q: np.ndarray, per_link: bool) -> Witness:
+    return checker(_FORKED_SCENE).closest(q, per_link)
+
+
+def closest(scene: Scene, q: np.ndarray, per_link: bool = False) -> Witness:
+    """Witnesses of a batch, split over all cores (forked workers) for large batches."""
+    workers = min(os.cpu_count() or 1, len(q) // (PARALLEL_MIN_BATCH // 2))
+    if workers < 2 or get_context().get_start_method() != "fork":
+        return checker(scene).closest(q, per_link)
+    global _FORKED_SCENE
+    _FORKED_SCENE = scene
+    chunks = np.array_split(q, workers)
+    with ProcessPoolExecutor(workers, mp_context=get_context("fork")) as pool:
+        parts = list(pool.map(_closest_in_worker, chunks, [per_link] * workers))
+    _FORKED_SCENE = None
+    return Witness(
+        *(
+            np.concatenate([getattr(p, f) for p in parts])
+            for f in ("distance", "point", "normal", "link")
+        )
+    )
+
+
 def signed_distance(scene: Scene, q: np.ndarray, per_link: bool = False) -> np.ndarray:
     """Exact signed collision distance f_cd (m): (B,), or (B, n_links) with ``per_link``.
 
-    Positive when free, negative (minus the penetration depth) when overlapping.
+    Positive when free, negative (minus the penetration depth) when overlapping. Batches of
+    ``PARALLEL_MIN_BATCH`` or more are split over the machine's cores.
     """
     q = scene.robot.check_q(q)
-    return checker(scene).closest(q, per_link).distance
+    return closest(scene, q, per_link).distance
 
 
 def signed_distance_and_grad(
@@ -192,7 +223,7 @@ def signed_distance_and_grad(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Signed distance and its exact gradient: ((B,), (B, dof)) or ((B, L), (B, L, dof))."""
     q = scene.robot.check_q(q)
-    w = checker(scene).closest(q, per_link)
+    w = closest(scene, q, per_link)
     return w.distance, witness_gradient(scene, q, w)
 
 

@@ -324,10 +324,9 @@ def as_batch(q: np.ndarray, dof: int, name: str = "q") -> np.ndarray:
         q = np.asarray(q, dtype=float)
     except (TypeError, ValueError) as e:
         raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from e
-    if q.ndim == 1:
-        q = q[None]
-    if q.ndim != 2 or q.shape[1] != dof:
+    if q.ndim not in (1, 2) or q.shape[-1] != dof:
         raise InputError(f"{name}: expected shape (B, {dof}) or ({dof},), got {q.shape}")
+    q = q.reshape(-1, dof)
     if not np.all(np.isfinite(q)):
         raise InputError(f"{name}: contains NaN or infinite values")
     return q

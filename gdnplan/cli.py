@@ -1,0 +1,84 @@
+"""The ``gdnplan`` command. Bad input prints one line (``error: …``) and exits with status 2."""
+
+from __future__ import annotations
+
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from .errors import GdnplanError, InputError, ProblemFileError
+from .scene import Scene, make_scene, scene_from_config
+
+app = typer.Typer(
+    help="Collision-free trajectory planning with GraphDistNet.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+
+
+@app.callback()
+def _commands() -> None:
+    """Collision-free trajectory planning with GraphDistNet."""
+
+
+def parse_vector(text: str, name: str) -> np.ndarray:
+    """'0.1, -0.2, 0.3' -> array; raises InputError naming ``name``."""
+    try:
+        return np.array([float(v) for v in text.replace(",", " ").split()])
+    except ValueError as e:
+        raise InputError(f"{name}: expected numbers separated by commas, got {text!r}") from e
+
+
+def read_toml(path: Path) -> dict:
+    """Parse a TOML file; raises ProblemFileError with the parser's line and column."""
+    if not path.exists():
+        raise ProblemFileError(f"{path}: no such file")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise ProblemFileError(f"{path}: malformed TOML ({e})") from e
+
+
+def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
+    """A scene from a problem TOML file (with its start q) or from a generator name."""
+    if target.endswith(".toml"):
+        cfg = read_toml(Path(target))
+        start = cfg.get("start", {}).get("q")
+        return scene_from_config(cfg), None if start is None else np.asarray(start, float)
+    return make_scene(target, seed=seed), None
+
+
+@app.command()
+def show(
+    target: str = typer.Argument(..., help="A problem TOML file or a scene name (a-e, fetch)."),
+    q: str = typer.Option(None, help="Joint angles 'q1,q2,...' (default: the problem's start)."),
+    seed: int = typer.Option(0, help="Scene seed, for generated scenes."),
+    out: Path = typer.Option(Path("scene.png"), help="Output PNG."),
+) -> None:
+    """Draw the robot, the obstacles and the witness segment of the signed distance."""
+    from .viz import save_figure, scene_figure
+
+    scene, start = scene_and_start(target, seed)
+    config = parse_vector(q, "--q") if q is not None else start
+    if config is not None:
+        config = scene.robot.check_q(config, "--q")[0]
+    fig = scene_figure(scene, config)
+    save_figure(fig, out)
+    typer.echo(f"wrote {out}")
+
+
+def main() -> None:
+    """Console entry point: run the app, turning GdnplanError into one line and exit code 2."""
+    try:
+        app()
+    except GdnplanError as e:
+        typer.echo(f"error: {e}", err=True)
+        sys.exit(2)
+
+
+if __name__ == "__main__":
+    main()

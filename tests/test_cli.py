@@ -1,0 +1,62 @@
+import subprocess
+import sys
+
+import pytest
+from typer.testing import CliRunner
+
+from gdnplan.cli import app
+
+runner = CliRunner()
+
+
+def test_show_writes_png(tmp_path):
+    out = tmp_path / "scene.png"
+    result = runner.invoke(
+        app, ["show", "d", "--seed", "3", "--q", "0.3,0.2,0.1,0.5,-0.4,0.6,0.2", "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    assert out.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_show_from_problem_file(tmp_path):
+    problem = tmp_path / "p.toml"
+    problem.write_text(
+        '[robot]\nname = "planar2"\n'
+        "[[obstacles]]\npolygon = [[0.5, 0.5], [0.8, 0.5], [0.8, 0.8]]\n"
+        "[start]\nq = [0.0, 0.1]\n"
+    )
+    out = tmp_path / "p.png"
+    result = runner.invoke(app, ["show", str(problem), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert out.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["show", "zz"], "scene: unknown name"),
+        (["show", "d", "--q", "1,2"], "--q: expected shape"),
+        (["show", "d", "--q", "1,x"], "--q: expected numbers"),
+        (["show", "missing.toml"], "no such file"),
+    ],
+)
+def test_bad_input_prints_one_line_and_exits_2(args, message):
+    proc = subprocess.run(
+        [sys.executable, "-c", "from gdnplan.cli import main; main()", *args],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and message in lines[0], proc.stderr
+
+
+def test_malformed_toml_names_the_file(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[robot\nname = 1")
+    proc = subprocess.run(
+        [sys.executable, "-c", "from gdnplan.cli import main; main()", "show", str(bad)],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 2 and "malformed TOML" in proc.stderr
