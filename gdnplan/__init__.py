@@ -1,7 +1,13 @@
 """gdnplan: collision-free trajectory planning with GraphDistNet, a learned collision distance."""
 
 from .distance import signed_distance, signed_distance_and_grad
-from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError, UnknownNameError
+from .errors import (
+    GdnplanError,
+    InfeasibleProblemError,
+    InputError,
+    ProblemFileError,
+    UnknownNameError,
+)
 from .models import CoalModel, DistanceModel
 from .robot import Robot, load_robot, robot_names
 from .scene import Scene, make_scene, scene_names
