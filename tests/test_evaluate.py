@@ -1,0 +1,67 @@
+"""Table I metrics against hand-computed cases, and one model evaluated end to end."""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+import gdnplan as gp
+from gdnplan import evaluate as ev
+from gdnplan.data import make_shard
+
+
+def test_mae_of_known_errors():
+    assert ev.mean_absolute_error(np.array([0.1, -0.2, 0.5]), np.array([0.0, 0.0, 0.2])) == (
+        pytest.approx((0.1 + 0.2 + 0.3) / 3)
+    )
+    with pytest.raises(gp.InputError):
+        ev.mean_absolute_error(np.zeros(3), np.zeros(2))
+
+
+def test_welch_p_value_matches_hand_computation():
+    a = np.array([0.12, 0.30, 0.25, 0.08, 0.41, 0.22])
+    b = np.array([0.05, 0.07, 0.02, 0.11, 0.04, 0.06, 0.09, 0.03])
+    va, vb = a.var(ddof=1) / len(a), b.var(ddof=1) / len(b)
+    t = (a.mean() - b.mean()) / np.sqrt(va + vb)
+    nu = (va + vb) ** 2 / (va**2 / (len(a) - 1) + vb**2 / (len(b) - 1))
+    p = 2 * stats.t.sf(abs(t), nu)
+    assert ev.welch_p_value(a, b) == pytest.approx(p, rel=1e-12)
+    assert ev.welch_p_value(a, b) < 0.05
+
+
+def test_auc_against_known_roc_with_ties():
+    # positives score 3, 2, 2; negatives 2, 1. Pairs (pos > neg) count 1, ties ½:
+    # 3 beats both (2), each 2 ties one and beats one (2 × 1.5) -> 5 / 6.
+    score = np.array([3.0, 2.0, 2.0, 2.0, 1.0])
+    pos = np.array([True, True, True, False, False])
+    assert ev.roc_auc(score, pos) == pytest.approx(5 / 6)
+    fpr, tpr = ev.roc_curve(score, pos)
+    np.testing.assert_allclose(fpr, [0, 0, 0.5, 1])
+    np.testing.assert_allclose(tpr, [0, 1 / 3, 1, 1])
+    assert np.trapezoid(tpr, fpr) == pytest.approx(5 / 6)
+    assert ev.roc_auc(np.arange(4.0), np.array([False, False, True, True])) == 1.0
+    assert ev.roc_auc(np.arange(4.0), np.array([True, True, False, False])) == 0.0
+    assert np.isnan(ev.roc_auc(np.arange(3.0), np.ones(3, bool)))
+
+
+def test_cosine_distance_of_known_vectors():
+    g = np.array([[1.0, 0.0], [0.0, 2.0], [1.0, 1.0], [0.0, 0.0], [3.0, 0.0]])
+    ref = np.array([[2.0, 0.0], [0.0, -1.0], [1.0, 0.0], [1.0, 0.0], [0.0, 0.0]])
+    np.testing.assert_allclose(
+        ev.cosine_distances(g, ref), [0.0, 2.0, 1 - np.sqrt(0.5), 1.0, 1.0], atol=1e-12
+    )
+    acd, used = ev.average_cosine_distance(g, ref)  # the zero coal gradient is left out
+    assert used == 4
+    assert acd == pytest.approx((0 + 2 + 1 - np.sqrt(0.5) + 1) / 4)
+
+
+def test_timed_returns_result_and_positive_time():
+    out, seconds = ev.timed(lambda: sum(range(1000)), repeats=3)
+    assert out == 499500 and 0 < seconds < 1
+
+
+def test_coal_scores_perfectly_on_random_env():
+    ds = make_shard("b", 1, 0, 60)
+    assert len(ev.scene_groups(ds)) == 60
+    res = ev.evaluate_model(gp.CoalModel(), "b", n=60, n_grad=30, ds=ds)
+    assert res.mae == pytest.approx(0, abs=1e-12) and res.acd == pytest.approx(0, abs=1e-9)
+    assert res.auc == 1.0 and res.n_grad == 30 and res.seconds > 0
