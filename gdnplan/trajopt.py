@@ -1,0 +1,614 @@
+"""Trajectory optimisation: Problem, Plan, Ipopt direct transcription, the paper's Adam baseline.
+
+Direct transcription over T waypoints Q = (q_0, …, q_{T−1}), q_0 = start, q_{T−1} = goal:
+
+    minimise    Σ_t ‖q_{t+1} − q_t‖²                                   (the paper's path cost)
+    subject to  lower ≤ q_t ≤ upper,   |q_{t+1} − q_t| ≤ max_step      (joint, step limits)
+                d(p_k) ≥ margin           for the K = T + (T−1)·M check points
+                                          p = q_t + i/(M+1) (q_{t+1} − q_t), i = 0 … M
+                d(p_k) + d(p_{k+1}) ≥ δ(p_k, p_{k+1}) + 2·margin              (CCD, optional)
+
+with d the overall or per-link distance of any DistanceModel (one batched call through
+:class:`~gdnplan.casadi_bridge.DistanceCallback`) and δ the conservative-advancement motion
+bound of :mod:`gdnplan.ccd` (smoothed |x| ≈ √(x² + ε²) ≥ |x|): the last rows certify that the
+continuous motion between consecutive check points keeps the margin. Ipopt with a
+limited-memory Hessian solves it from a straight-line or RRT-Connect seed, restarting from new
+seeds on failure. A plan succeeds only when :func:`gdnplan.ccd.verify_path` certifies the
+returned path with coal and the goal is reached — never on the solver's word alone.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import casadi
+import numpy as np
+import pinocchio as pin
+
+from .casadi_bridge import DistanceCallback
+from .ccd import certify_path, lever_arms, verify_path
+from .distance import signed_distance
+from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
+from .models import CoalModel, DistanceModel
+from .robot import Robot
+from .rrt import seed_path
+from .scene import Scene, scene_from_config
+
+WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
+TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options"}
+OPTION_KEYS = {"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"}
+
+
+# -------------------------------------------------------------------- end effector
+def tip_point(robot: Robot) -> np.ndarray:
+    """(2,) plane position at q = 0 of the robot's last frame (its tip / end effector)."""
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, np.zeros(robot.dof))
+    return robot.plane.project(data.oMf[robot.model.nframes - 1].translation)
+
+
+def tip_position(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """(B, 2) end-effector positions (m) at q (B, dof)."""
+    q = robot.check_q(q)
+    return robot.chain.transform(tip_point(robot)[None], np.array([robot.dof]), q)[:, 0]
+
+
+def tip_reach(robot: Robot) -> float:
+    """Largest possible distance of the tip from joint 1 (m), chained over joint distances."""
+    o = robot.chain.joint_origins
+    hops = np.sum(np.linalg.norm(np.diff(o, axis=0), axis=1))
+    return float(hops + np.linalg.norm(tip_point(robot) - o[-1]))
+
+
+# -------------------------------------------------------------------- problem
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """A planning problem: move the robot of ``scene`` from ``start`` to a goal.
+
+    Attributes:
+        scene: robot and obstacles.
+        start: (dof,) start joint angles (rad).
+        goal: (dof,) goal joint angles (rad), or None when ``goal_position`` is given.
+        goal_position: (2,) end-effector goal in the plane (m), or None.
+        waypoints: T ≥ 3, waypoints including start and goal.
+        margin: required clearance d ≥ margin (m).
+        max_step: largest change of any joint between consecutive waypoints (rad).
+        goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
+        lower, upper: (dof,) joint limits (rad); the robot's limits when None.
+    """
+
+    scene: Scene
+    start: np.ndarray
+    goal: np.ndarray | None = None
+    goal_position: np.ndarray | None = None
+    waypoints: int = 20
+    margin: float = 0.02
+    max_step: float = 1.0
+    goal_tolerance: float = 1e-3
+    lower: np.ndarray = field(default=None)  # type: ignore[assignment]
+    upper: np.ndarray = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        robot = self.scene.robot
+        set_ = object.__setattr__
+        set_(
+            self,
+            "lower",
+            _vector(robot.lower if self.lower is None else self.lower, robot.dof, "options.lower"),
+        )
+        set_(
+            self,
+            "upper",
+            _vector(robot.upper if self.upper is None else self.upper, robot.dof, "options.upper"),
+        )
+        set_(self, "start", _vector(self.start, robot.dof, "start.q"))
+        if (self.goal is None) == (self.goal_position is None):
+            raise InputError("goal: give exactly one of q (joint angles) or position ([x, y])")
+        if self.goal is not None:
+            set_(self, "goal", _vector(self.goal, robot.dof, "goal.q"))
+        else:
+            set_(self, "goal_position", _vector(self.goal_position, 2, "goal.position"))
+        if not (isinstance(self.waypoints, int) and self.waypoints >= 3):
+            raise InputError(f"options.waypoints: expected an integer ≥ 3, got {self.waypoints!r}")
+        for name in ("margin", "max_step", "goal_tolerance"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise InputError(f"options.{name}: expected a finite number ≥ 0, got {value!r}")
+        if self.max_step <= 0 or self.goal_tolerance <= 0:
+            raise InputError("options.max_step and options.goal_tolerance must be > 0")
+        self._check_feasible()
+
+    def _check_feasible(self) -> None:
+        """Start and goal inside the limits and clear of obstacles, goal position in reach."""
+        named = [("start.q", self.start)] + (
+            [("goal.q", self.goal)] if self.goal is not None else []
+        )
+        for name, q in named:
+            out = np.flatnonzero((q < self.lower - 1e-9) | (q > self.upper + 1e-9))
+            if out.size:
+                j = int(out[0])
+                raise InfeasibleProblemError(
+                    f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
+                    f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
+                )
+            d = float(signed_distance(self.scene, q)[0])
+            if d <= self.margin:
+                raise InfeasibleProblemError(
+                    f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m; "
+                    "move it away from the obstacles or lower options.margin"
+                )
+        if self.goal_position is not None:
+            robot = self.scene.robot
+            r = float(np.linalg.norm(self.goal_position - robot.chain.joint_origins[0]))
+            if r > tip_reach(robot):
+                raise InfeasibleProblemError(
+                    f"goal.position {self.goal_position.tolist()} is out of reach: {r:.3f} m "
+                    f"from the base, the tip reaches {tip_reach(robot):.3f} m"
+                )
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Problem:
+        """Load a problem file (schema in DESIGN.md); ProblemFileError names any bad field."""
+        path = Path(path)
+        try:
+            cfg = tomllib.loads(path.read_text())
+        except OSError as e:
+            raise ProblemFileError(f"{path}: cannot read the problem file ({e.strerror})") from e
+        except tomllib.TOMLDecodeError as e:
+            raise ProblemFileError(f"{path}: malformed TOML: {e}") from e
+        try:
+            return cls.from_config(cfg)
+        except ProblemFileError as e:
+            raise ProblemFileError(f"{path}: {e}") from e
+
+    @classmethod
+    def from_config(cls, cfg: dict) -> Problem:
+        """Problem from a parsed TOML mapping (see :meth:`from_toml`)."""
+        _no_unknown(cfg, TOP_KEYS, "top level")
+        for key in ("start", "goal"):
+            if not isinstance(cfg.get(key), dict):
+                raise ProblemFileError(f"[{key}]: missing table")
+        _no_unknown(cfg["start"], {"q"}, "[start]")
+        _no_unknown(cfg["goal"], {"q", "position"}, "[goal]")
+        options = cfg.get("options", {})
+        if not isinstance(options, dict):
+            raise ProblemFileError("[options]: expected a table")
+        _no_unknown(options, OPTION_KEYS, "[options]")
+        try:
+            scene = scene_from_config(cfg)
+        except TypeError as e:
+            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
+        goal = cfg["goal"]
+        if ("q" in goal) == ("position" in goal):
+            raise ProblemFileError("[goal]: give exactly one of q = [...] or position = [x, y]")
+        if "q" not in cfg["start"]:
+            raise ProblemFileError("[start] q: missing; give the start joint angles")
+        try:
+            return cls(
+                scene=scene,
+                start=cfg["start"]["q"],
+                goal=goal.get("q"),
+                goal_position=goal.get("position"),
+                **options,
+            )
+        except InputError as e:
+            raise ProblemFileError(str(e)) from e
+
+
+def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise ProblemFileError(f"{where}: unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+
+
+def _vector(value, n: int, name: str) -> np.ndarray:
+    """A finite float (n,) vector or InputError naming the field."""
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"{name}: expected {n} numbers, got {value!r}") from e
+    if v.shape != (n,):
+        raise InputError(f"{name}: expected {n} numbers, got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise InputError(f"{name}: contains NaN or infinite values")
+    v.setflags(write=False)
+    return v
+
+
+# -------------------------------------------------------------------- goal position -> q
+def solve_ik(
+    problem: Problem, seed: int = 0, restarts: int = 64, iterations: int = 100
+) -> np.ndarray:
+    """Collision-free joint goal (dof,) whose tip is at ``problem.goal_position``.
+
+    Batched damped least squares Δq = Jᵀ(JJᵀ + λ²I)⁻¹ e from the start and ``restarts`` random
+    configurations, clipped to the limits; among solutions within ``goal_tolerance`` and clear
+    of the margin, the one closest to the start. Raises InfeasibleProblemError if none exists.
+    """
+    robot, target = problem.scene.robot, problem.goal_position
+    rng = np.random.default_rng(seed)
+    q = np.vstack([problem.start, rng.uniform(problem.lower, problem.upper, (restarts, robot.dof))])
+    tip0, body = tip_point(robot)[None], np.array([robot.dof])
+    for _ in range(iterations):
+        p = robot.chain.transform(tip0, body, q)
+        jac = robot.chain.jacobian(p, body, q)[:, 0]  # (B, 2, dof)
+        err = target - p[:, 0]
+        jjt = jac @ np.swapaxes(jac, 1, 2) + 1e-4 * np.eye(2)
+        step = np.einsum("bji,bj->bi", jac, np.linalg.solve(jjt, err[..., None])[..., 0])
+        q = np.clip(q + step, problem.lower, problem.upper)
+    err = np.linalg.norm(tip_position(robot, q) - target, axis=1)
+    ok = err <= problem.goal_tolerance / 2
+    if ok.any():
+        ok[ok] = signed_distance(problem.scene, q[ok]) > problem.margin
+    if not ok.any():
+        raise InfeasibleProblemError(
+            f"goal.position {target.tolist()}: no collision-free joint configuration within the "
+            "limits reaches it; move the goal or lower options.margin"
+        )
+    candidates = q[ok]
+    return candidates[np.argmin(np.linalg.norm(candidates - problem.start, axis=1))]
+
+
+# -------------------------------------------------------------------- plan
+@dataclass(frozen=True)
+class TrajoptOptions:
+    """Solver settings (defaults are the benchmarked configuration).
+
+    Attributes:
+        initial: "auto" (straight line when certified free, else RRT-Connect seeds),
+            "straight" (always the straight line) or "rrt" (always RRT-Connect seeds).
+        ccd: add the conservative-advancement rows between consecutive check points.
+        per_link: one distance row per link polygon (capped at ``link_cap``) instead of one.
+        interpolated: M check points strictly between consecutive waypoints.
+        starts: Ipopt attempts (new seed path each) before giving up.
+        max_iter: Ipopt iteration cap per attempt.
+        tol: Ipopt tolerance.
+        rrt_clearance: extra clearance (m) above the margin demanded of seed paths.
+        rrt_time: time limit of one RRT-Connect run (s).
+        link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
+        adam_iterations, adam_lr, adam_c, adam_eps, adam_stop: the paper's Adam optimiser:
+            iteration cap, step size (rad), cost constant c, ε, and the stop clearance (m).
+    """
+
+    initial: str = "auto"
+    ccd: bool = True
+    per_link: bool = True
+    interpolated: int = 3
+    starts: int = 3
+    max_iter: int = 300
+    tol: float = 1e-4
+    rrt_clearance: float = 0.02
+    rrt_time: float = 5.0
+    link_cap: float = 0.3
+    adam_iterations: int = 500
+    adam_lr: float = 0.01
+    adam_c: float = 1e-3
+    adam_eps: float = 1e-3
+    adam_stop: float = 0.01
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """Result of :func:`plan`.
+
+    Attributes:
+        success: the certified coal check passed and the goal is reached.
+        q: (T, dof) waypoints (rad).
+        min_distance: smallest coal distance of the certified dense check (m).
+        solve_time: wall time of the whole call: seeds, solves, verification (s).
+        iterations: solver iterations summed over attempts.
+        status: the solver's last return status (Ipopt's, or "adam: …").
+        reason: why the plan failed (or which attempt succeeded).
+        path_cost: Σ_t ‖q_{t+1} − q_t‖² (rad²).
+        model_calls: batched distance-model calls made by the solver.
+        attempts: solver runs made.
+    """
+
+    success: bool
+    q: np.ndarray
+    min_distance: float
+    solve_time: float
+    iterations: int
+    status: str
+    reason: str
+    path_cost: float
+    model_calls: int
+    attempts: int
+
+
+def path_cost(q: np.ndarray) -> float:
+    """Σ_t ‖q_{t+1} − q_t‖² of a (T, dof) path (rad²)."""
+    return float(np.sum(np.diff(q, axis=0) ** 2))
+
+
+def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | Path | None):
+    """The DistanceModel named by ``collision`` ("coal", "graphdistnet" or a model instance)."""
+    if not isinstance(collision, str):
+        if not isinstance(collision, DistanceModel):
+            raise InputError(
+                f"collision: expected 'coal', 'graphdistnet' or a DistanceModel, "
+                f"got {type(collision).__name__}"
+            )
+        return collision
+    if collision == "coal":
+        return CoalModel()
+    if collision != "graphdistnet":
+        raise InputError(f"collision: unknown {collision!r}; choose 'coal' or 'graphdistnet'")
+    path = Path(weights) if weights is not None else WEIGHTS_DIR / f"{scene.name}.safetensors"
+    if not path.exists():
+        raise InputError(
+            f"weights: {path} does not exist; train GraphDistNet for environment "
+            f"{scene.name!r} first or pass weights=<file.safetensors>"
+        )
+    from . import models
+
+    if not hasattr(models, "load_model"):
+        raise InputError("collision='graphdistnet': this version has no GraphDistNet loader")
+    return models.load_model(path)
+
+
+def plan(
+    problem: Problem,
+    collision: str | DistanceModel = "coal",
+    solver: str = "ipopt",
+    weights: str | Path | None = None,
+    seed: int = 0,
+    options: TrajoptOptions | None = None,
+) -> Plan:
+    """Plan a trajectory for ``problem``; see the module docstring for the formulation.
+
+    Raises GdnplanError on bad input; a failed solve returns ``Plan(success=False, reason=…)``.
+    """
+    t0 = time.perf_counter()
+    opts = options or TrajoptOptions()
+    model = resolve_model(collision, problem.scene, weights)
+    goal = problem.goal if problem.goal is not None else solve_ik(problem, seed)
+    if solver == "ipopt":
+        run = _plan_ipopt(problem, model, goal, opts, seed)
+    elif solver == "adam":
+        run = _plan_adam(problem, model, goal, opts)
+    else:
+        raise InputError(f"solver: unknown {solver!r}; choose 'ipopt' or 'adam'")
+    return _finish(problem, run, t0)
+
+
+@dataclass
+class _Run:
+    """What a solver hands back before verification."""
+
+    q: np.ndarray
+    iterations: int = 0
+    status: str = ""
+    reason: str = ""
+    model_calls: int = 0
+    attempts: int = 0
+    verified: tuple[bool, float] | None = None
+
+
+def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
+    """Certify the path with coal, check the goal, package the Plan."""
+    ok, dmin = run.verified or verify_path(problem.scene, run.q, margin=0.0)
+    reached = _goal_error(problem, run.q[-1]) <= problem.goal_tolerance
+    reason = run.reason
+    if not ok:
+        reason = f"{reason}; certified coal check failed (min distance {dmin:.4f} m)"
+    elif not reached:
+        reason = f"{reason}; goal not reached"
+    return Plan(
+        success=bool(ok and reached),
+        q=run.q,
+        min_distance=dmin,
+        solve_time=time.perf_counter() - t0,
+        iterations=run.iterations,
+        status=run.status,
+        reason=reason.lstrip("; "),
+        path_cost=path_cost(run.q),
+        model_calls=run.model_calls,
+        attempts=run.attempts,
+    )
+
+
+def _goal_error(problem: Problem, q: np.ndarray) -> float:
+    """Joint-space (rad, ∞-norm) or end-effector (m) distance of q to the goal."""
+    if problem.goal is not None:
+        return float(np.max(np.abs(q - problem.goal)))
+    return float(np.linalg.norm(tip_position(problem.scene.robot, q)[0] - problem.goal_position))
+
+
+def straight_line(start: np.ndarray, goal: np.ndarray, n: int) -> np.ndarray:
+    """(n, dof) evenly spaced joint-space interpolation from start to goal."""
+    s = np.linspace(0.0, 1.0, n)[:, None]
+    return start + s * (goal - start)
+
+
+# -------------------------------------------------------------------- Ipopt
+def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
+    """Yield (label, initial guess (T, dof) or None when RRT-Connect failed) per attempt."""
+    line = straight_line(problem.start, goal, problem.waypoints)
+    use_line = opts.initial == "straight" or (
+        opts.initial == "auto"
+        and certify_path(problem.scene, line, problem.margin, stop_early=True).ok
+    )
+    rng = np.random.default_rng(seed)
+    for attempt in range(opts.starts):
+        if use_line:
+            guess = line.copy()
+            if attempt:  # restarts perturb the interior waypoints by N(0, 0.2 rad)
+                guess[1:-1] += rng.normal(0, 0.2, guess[1:-1].shape)
+                guess = np.clip(guess, problem.lower, problem.upper)
+            yield "straight line" + (f" (perturbed {attempt})" if attempt else ""), guess
+            continue
+        guess, _ = seed_path(
+            problem.scene,
+            problem.start,
+            goal,
+            problem.waypoints,
+            problem.margin + opts.rrt_clearance,
+            seed=seed + attempt,
+            time_limit=opts.rrt_time,
+        )
+        yield f"RRT-Connect seed {seed + attempt}", guess
+
+
+def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, seed: int) -> _Run:
+    nlp = _Transcription(problem, model, goal, opts)
+    run = _Run(q=straight_line(problem.start, goal, problem.waypoints))
+    for label, guess in _seeds(problem, goal, opts, seed):
+        run.attempts += 1
+        if guess is None:
+            run.reason = f"{run.reason}; {label}: RRT-Connect found no path".lstrip("; ")
+            continue
+        q, stats = nlp.solve(guess)
+        run.iterations += stats.get("iter_count", 0)
+        run.status = stats.get("return_status", "exception")
+        run.q = q
+        run.verified = verify_path(problem.scene, q, margin=0.0)
+        if run.verified[0]:
+            run.reason = f"{label}: {run.status}"
+            break
+        run.reason = f"{run.reason}; {label}: {run.status}, path not certified".lstrip("; ")
+    run.model_calls = nlp.callback.model_calls
+    return run
+
+
+class _Transcription:
+    """The NLP of the module docstring, built once and solved from several initial guesses."""
+
+    def __init__(self, problem: Problem, model: DistanceModel, goal: np.ndarray, opts):
+        robot = problem.scene.robot
+        T, n, M = problem.waypoints, robot.dof, opts.interpolated
+        self.problem, self.goal, self.T = problem, goal, T
+        x = casadi.MX.sym("x", (T - 2) * n)
+        Q = casadi.vertcat(
+            casadi.DM(problem.start).T, casadi.reshape(x, n, T - 2).T, casadi.DM(goal).T
+        )  # (T, n)
+        W = _interpolation_matrix(T, M)  # (K, T)
+        P = casadi.mtimes(casadi.sparsify(casadi.DM(W)), Q)  # (K, n) check points along the path
+        K = W.shape[0]
+        self.callback = DistanceCallback(
+            "distance", model, problem.scene, K, opts.per_link, opts.link_cap
+        )
+        rows = self.callback.rows
+        d = casadi.reshape(self.callback(casadi.reshape(P.T, K * n, 1)), rows, K).T  # (K, R)
+        g = [casadi.reshape(d - problem.margin, K * rows, 1)]
+        lbg = [np.zeros(K * rows)]
+        if opts.ccd:
+            arms = lever_arms(robot) if opts.per_link else lever_arms(robot).max(0, keepdims=True)
+            dq = P[1:, :] - P[:-1, :]
+            delta = casadi.mtimes(casadi.sqrt(dq**2 + 1e-8), casadi.sparsify(casadi.DM(arms.T)))  # (K-1, R)
+            cert = d[:-1, :] + d[1:, :] - delta - 2 * problem.margin
+            g.append(casadi.reshape(cert, (K - 1) * rows, 1))
+            lbg.append(np.zeros((K - 1) * rows))
+        steps = Q[1:, :] - Q[:-1, :]
+        g.append(casadi.reshape(steps, (T - 1) * n, 1))
+        lbg.append(np.full((T - 1) * n, -problem.max_step))
+        ubg = [np.full(len(b), np.inf) for b in lbg[:-1]] + [np.full((T - 1) * n, problem.max_step)]
+        self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
+        self.lbx = np.tile(problem.lower, T - 2)
+        self.ubx = np.tile(problem.upper, T - 2)
+        f = casadi.sumsqr(steps)
+        ipopt = {
+            "hessian_approximation": "limited-memory",
+            "print_level": 0,
+            "max_iter": opts.max_iter,
+            "tol": opts.tol,
+            "acceptable_tol": 1e-3,
+            "acceptable_iter": 5,
+            "mu_strategy": "adaptive",
+        }
+        self.solver = casadi.nlpsol(
+            "trajopt",
+            "ipopt",
+            {"x": x, "f": f, "g": casadi.vertcat(*g)},
+            {"ipopt": ipopt, "print_time": False, "error_on_fail": False},
+        )
+
+    def solve(self, guess: np.ndarray) -> tuple[np.ndarray, dict]:
+        """Solve from an initial guess (T, dof); returns the waypoints (T, dof) and Ipopt stats."""
+        x0 = np.clip(guess[1:-1], self.problem.lower, self.problem.upper).ravel()
+        try:
+            sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        except RuntimeError as e:
+            return guess, {"return_status": f"exception: {str(e).splitlines()[-1]}"}
+        inner = np.asarray(sol["x"]).reshape(self.T - 2, -1)
+        stats = self.solver.stats()
+        return np.vstack([self.problem.start, inner, self.goal]), stats
+
+
+def _interpolation_matrix(T: int, M: int) -> np.ndarray:
+    """(T + (T−1)·M, T) weights: row k of W·Q is the k-th check point along the path."""
+    rows = []
+    for t in range(T - 1):
+        for i in range(M + 1):
+            w = np.zeros(T)
+            s = i / (M + 1)
+            w[t], w[t + 1] = 1 - s, s
+            rows.append(w)
+    last = np.zeros(T)
+    last[-1] = 1.0
+    rows.append(last)
+    return np.array(rows)
+
+
+# -------------------------------------------------------------------- Adam (the paper's)
+def collision_cost(
+    d: np.ndarray, margin: float, c: float, eps: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's C(d) = c / ((d − d_margin)² + ε) for d ≥ d_margin and its derivative.
+
+    Below the margin the paper's form would fall again (pushing deeper into collision), so
+    there C continues linearly with slope −c/ε per metre: C = c/ε + (c/ε)(d_margin − d)/√ε.
+    """
+    gap = d - margin
+    above = gap >= 0
+    slope = c / eps / math.sqrt(eps)
+    cost = np.where(above, c / (gap**2 + eps), c / eps - slope * gap)
+    dcost = np.where(above, -2 * c * gap / (gap**2 + eps) ** 2, -slope)
+    return cost, dcost
+
+
+def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -> _Run:
+    """Adam on the interior waypoints of Σ_k C(d(p_k)) + Σ_t ‖q_{t+1} − q_t‖², from the
+    straight line, until every check point has d ≥ margin + adam_stop or the iteration cap."""
+    T, M = problem.waypoints, opts.interpolated
+    W = _interpolation_matrix(T, M)
+    q = straight_line(problem.start, goal, T)
+    m, v = np.zeros_like(q), np.zeros_like(q)
+    b1, b2 = 0.9, 0.999
+    calls, status = 0, "adam: iteration cap"
+    for it in range(1, opts.adam_iterations + 1):
+        P = W @ q
+        d, g = model.distance_and_grad(problem.scene, P)
+        calls += 1
+        if np.min(d) >= problem.margin + opts.adam_stop:
+            status = "adam: cost below threshold"
+            break
+        _, dc = collision_cost(np.asarray(d), problem.margin, opts.adam_c, opts.adam_eps)
+        grad = W.T @ (dc[:, None] * g)
+        grad[1:] += 2 * (q[1:] - q[:-1])
+        grad[:-1] -= 2 * (q[1:] - q[:-1])
+        grad[[0, -1]] = 0.0
+        m = b1 * m + (1 - b1) * grad
+        v = b2 * v + (1 - b2) * grad**2
+        step = opts.adam_lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
+        q = np.clip(q - step, problem.lower, problem.upper)
+    return _Run(q=q, iterations=it, status=status, reason=status, model_calls=calls, attempts=1)
+
+
+__all__ = [
+    "GdnplanError",
+    "Plan",
+    "Problem",
+    "TrajoptOptions",
+    "collision_cost",
+    "path_cost",
+    "plan",
+    "solve_ik",
+    "straight_line",
+    "tip_position",
+    "verify_path",
+]
