@@ -407,6 +407,26 @@ def robot_from_urdf(
     ``(name, frame_name, vertices (m, 2) in plane coordinates at q = 0)``.
     """
     model, geom = _load_urdf(spec)
+    return robot_from_models(name, model, geom, spec, limits, extra_polygons, skip_geometry, info)
+
+
+def robot_from_models(
+    name: str,
+    model: pin.Model,
+    geom: pin.GeometryModel,
+    spec: RobotSpec,
+    limits: tuple[np.ndarray, np.ndarray] | None = None,
+    extra_polygons: Sequence[tuple[str, str, np.ndarray]] = (),
+    skip_geometry: Callable[[str], bool] = lambda _: False,
+    info: dict | None = None,
+    group: Callable[[str], str] | None = None,
+) -> Robot:
+    """:func:`robot_from_urdf` on an already-built full model and its collision geometry.
+
+    ``spec.urdf`` only names the source in messages and ``info``. ``group`` maps geometry
+    names to polygon names: geometries of one group (all on one body) share one polygon, the
+    convex hull of their joint projection. Without it every geometry is its own polygon.
+    """
     q_ref = pin.neutral(model)
     for jname, value in spec.locked.items():
         if not model.existJointName(jname):
@@ -429,13 +449,20 @@ def robot_from_urdf(
     origin = data.oMi[1].translation.copy()
     plane = Plane(origin=origin, axes=np.asarray(spec.plane_axes, dtype=float))
 
-    polygons = []
+    groups: dict[tuple, tuple[int, list[np.ndarray]]] = {}  # (key, name) -> (frame, points)
     for g, obj in enumerate(reduced_geom.geometryObjects):
         if skip_geometry(obj.name):
             continue
         pts = apply_se3(gdata.oMg[g], geometry_points(obj.geometry))
-        uv = simplify_convex(convex_hull(plane.project(pts)), spec.max_vertices)
-        polygons.append(_attach(reduced, data, plane, obj.name, obj.parentFrame, uv))
+        key = (g, obj.name) if group is None else (None, group(obj.name))
+        frame, clouds = groups.setdefault(key, (obj.parentFrame, []))
+        if reduced.frames[frame].parentJoint != reduced.frames[obj.parentFrame].parentJoint:
+            raise InputError(f"{name}: geometry {obj.name!r} moves apart from group {key[1]!r}")
+        clouds.append(plane.project(pts))
+    polygons = []
+    for (_, pname), (frame, clouds) in groups.items():
+        uv = simplify_convex(convex_hull(np.concatenate(clouds)), spec.max_vertices)
+        polygons.append(_attach(reduced, data, plane, pname, frame, uv))
     for pname, frame_name, uv in extra_polygons:
         if not reduced.existFrame(frame_name):
             raise UnknownNameError(f"{name}: frame {frame_name!r} does not exist")
