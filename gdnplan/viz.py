@@ -64,3 +64,65 @@ def save_figure(fig: Figure, path) -> None:
     tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
     fig.savefig(tmp, dpi=120)
     os.replace(tmp, path)
+
+
+def interpolate_path(q_path: np.ndarray, per_segment: int) -> np.ndarray:
+    """Linear interpolation of a path (T, dof) with ``per_segment`` steps per segment.
+
+    Returns ((T − 1) · per_segment + 1, dof) configurations, the waypoints included.
+    """
+    q_path = np.asarray(q_path, dtype=float)
+    t = np.arange(per_segment)[:, None] / per_segment
+    inner = q_path[:-1, None] + t[None] * (q_path[1:] - q_path[:-1])[:, None]
+    return np.concatenate([inner.reshape(-1, q_path.shape[1]), q_path[-1:]])
+
+
+def animate_paths(
+    stages: list[tuple[Scene, np.ndarray]],
+    out,
+    per_segment: int = 3,
+    fps: int = 12,
+    title: str = "",
+) -> None:
+    """GIF of the robot following one or more paths, with the coal clearance over time.
+
+    Args:
+        stages: (scene, path (T, dof)) pairs played one after the other; the scene may change
+            between stages (e.g. the gripper closes on an object).
+        out: output ``.gif`` path (written atomically).
+        per_segment: frames per path segment.
+        fps: frames per second.
+        title: figure title.
+    """
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    from .distance import signed_distance
+
+    frames = []  # (stage index, q)
+    for s, (_, path) in enumerate(stages):
+        frames += [(s, q) for q in interpolate_path(path, per_segment)]
+    clearance = np.concatenate(
+        [signed_distance(scene, interpolate_path(path, per_segment)) for scene, path in stages]
+    )
+    fig = Figure(figsize=(10, 4.8))
+    ax_scene, ax_clear = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
+    ax_clear.plot(clearance, "k-", linewidth=1)
+    ax_clear.axhline(0.0, color="tab:red", linewidth=1)
+    ax_clear.set_xlabel("frame")
+    ax_clear.set_ylabel("coal clearance (m)")
+    ax_clear.grid(alpha=0.3)
+    (marker,) = ax_clear.plot([], [], "o", color="tab:red")
+    fig.suptitle(title)
+
+    def draw(i: int):
+        s, q = frames[i]
+        ax_scene.clear()
+        draw_scene(ax_scene, stages[s][0], q, show_witness=True)
+        marker.set_data([i], [clearance[i]])
+        return ()
+
+    anim = FuncAnimation(fig, draw, frames=len(frames), blit=False)
+    out = Path(out)
+    tmp = out.with_name(f".{out.name}.tmp.gif")
+    anim.save(tmp, writer=PillowWriter(fps=fps))
+    os.replace(tmp, out)
