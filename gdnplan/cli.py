@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import tomllib
 from pathlib import Path
@@ -69,6 +70,59 @@ def show(
     fig = scene_figure(scene, config)
     save_figure(fig, out)
     typer.echo(f"wrote {out}")
+
+
+@app.command("plan")
+def plan_command(
+    problem_file: Path = typer.Argument(..., help="Problem TOML file (see problems/)."),
+    collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
+    solver: str = typer.Option("ipopt", help="ipopt (direct transcription) or adam (paper)."),
+    weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/<env>)."),
+    seed: int = typer.Option(0, help="Seed of the sampling-based initial guesses."),
+    json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
+) -> None:
+    """Plan a collision-free trajectory; success is certified by a dense coal check.
+
+    Exit status: 0 when the plan is certified, 1 when planning failed, 2 on bad input.
+    """
+    from .trajopt import Problem, plan
+
+    problem = Problem.from_toml(problem_file)
+    result = plan(problem, collision=collision, solver=solver, weights=weights, seed=seed)
+    if json_output:
+        typer.echo(json.dumps(plan_summary(result)))
+    else:
+        verdict = "certified collision-free" if result.success else f"FAILED ({result.reason})"
+        typer.echo(
+            f"{problem_file}: {verdict}; coal clearance {result.min_distance:+.4f} m, "
+            f"solve time {result.solve_time:.2f} s, {result.iterations} iterations, "
+            f"path cost {result.path_cost:.3f}"
+        )
+    if animate is not None:
+        from .viz import animate_paths
+
+        animate_paths(
+            [(problem.scene, result.q)], animate, title=f"{problem_file.name}: {collision}"
+        )
+        if not json_output:
+            typer.echo(f"wrote {animate}")
+    if not result.success:
+        raise typer.Exit(1)
+
+
+def plan_summary(result) -> dict:
+    """JSON-ready summary of a Plan."""
+    return {
+        "success": bool(result.success),
+        "q": np.asarray(result.q).tolist(),
+        "min_distance": float(result.min_distance),
+        "solve_time": float(result.solve_time),
+        "iterations": int(result.iterations),
+        "status": result.status,
+        "reason": result.reason,
+        "path_cost": float(result.path_cost),
+    }
 
 
 def main() -> None:
