@@ -1,5 +1,6 @@
 """gdnplan: collision-free trajectory planning with GraphDistNet, a learned collision distance."""
 
+from . import ur5e  # noqa: F401  (registers the ur5e and ur5 robots and the fetch scene)
 from .distance import signed_distance, signed_distance_and_grad
 from .errors import (
     GdnplanError,
