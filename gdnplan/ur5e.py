@@ -37,6 +37,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -630,3 +631,44 @@ def plot_fetch(scene: Scene, q: np.ndarray, path: str) -> None:
     ax.legend(loc="upper right", fontsize=7)
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
+
+
+UR5_GROUPS = {
+    "base_link": "base",
+    "shoulder_link": "base",
+    "upper_arm_link": "upper_arm",
+    "forearm_link": "forearm",
+    "wrist_1_link": "wrist",
+    "wrist_2_link": "hand",
+    "wrist_3_link": "hand",
+    "ee_link": "hand",
+}
+
+
+@register_robot("ur5")
+def ur5() -> Robot:
+    """The classic UR5 of example-robot-data, polygons projected from its collision meshes.
+
+    Same plane, planning joints and limits as the UR5e; wrist_2 = π/2 puts the tool axis
+    in the plane (along +u at q = 0). Polygons: base, upper_arm, forearm, wrist, hand.
+    """
+    import example_robot_data
+
+    loaded = example_robot_data.load("ur5")
+    spec = RobotSpec(
+        urdf=Path(loaded.urdf),
+        planning_joints=PLANNING_JOINTS,
+        locked={"shoulder_pan_joint": 0.0, "wrist_2_joint": PI / 2, "wrist_3_joint": 0.0},
+        plane_axes=PLANE_AXES,
+        max_vertices=12,
+        base_radius=0.2,
+    )
+    return robot_from_models(
+        "ur5",
+        loaded.model,
+        loaded.collision_model,
+        spec,
+        PLANNING_LIMITS,
+        info={"source": "example-robot-data ur5"},
+        group=lambda name: UR5_GROUPS[name.rsplit("_", 1)[0]],
+    )
