@@ -125,6 +125,100 @@ def plan_summary(result) -> dict:
     }
 
 
+reproduce_app = typer.Typer(help="Reproduce the paper's tables.", no_args_is_help=True)
+app.add_typer(reproduce_app, name="reproduce")
+
+EVAL_MODELS = ("coal", "diffco", "clearancenet", "graphdistnet")
+
+
+@app.command("evaluate")
+def evaluate_command(
+    env: str = typer.Option("a", help="Environment a-e (its held-out split, seed 1)."),
+    model: str = typer.Option("graphdistnet", help="coal | diffco | clearancenet | graphdistnet."),
+    n: int = typer.Option(5000, help="Held-out samples (time, MAE, AUC)."),
+    n_grad: int = typer.Option(2000, help="Samples for the ACD."),
+) -> None:
+    """Time, MAE, AUC and ACD of one collision model on held-out samples (Table I metrics)."""
+    from . import evaluate as ev
+    from .scene import make_scene
+
+    if model not in EVAL_MODELS:
+        raise InputError(f"--model: unknown {model!r}; choose one of {list(EVAL_MODELS)}")
+    if model == "coal":
+        from .models import CoalModel
+
+        chosen = CoalModel()
+    elif model == "diffco":
+        from .models.diffco import DiffCo
+
+        chosen = DiffCo.train(make_scene(ev.DIFFCO_SOURCE.get(env, env)), n=3000)
+    else:
+        loader = ev.load_clearancenet if model == "clearancenet" else ev.load_graphdistnet
+        chosen = loader(env)
+        if chosen is None:
+            raise InputError(f"--model: no {model} weights for env {env} in weights/")
+    r = ev.evaluate_model(chosen, env, n, n_grad)
+    mae = "N/A" if r.mae is None else f"{r.mae:.4f} m ({r.mae_reach:.4f} of reach)"
+    acd = "N/A" if r.acd is None else f"{r.acd:.4f} over {r.n_grad}"
+    typer.echo(
+        f"{model} env {env}: n={r.n} time {r.seconds:.4f} s, MAE {mae}, AUC {r.auc:.4f}, ACD {acd}"
+    )
+
+
+@reproduce_app.command("table1")
+def table1_command(
+    fast: bool = typer.Option(False, "--fast", help="Few samples (CI); the full run is recorded."),
+    envs: str = typer.Option("abcde", help="Environments to run, e.g. 'ab'."),
+    out: Path = typer.Option(Path("results/table1.md"), help="Markdown output."),
+    figures: Path = typer.Option(None, help="Directory for ROC/scatter PNGs (default: none)."),
+) -> None:
+    """The paper's Table I, ours beside the paper's numbers; markdown to stdout and ``out``."""
+    import datetime
+    import os
+    import platform
+
+    from . import evaluate as ev
+
+    if not envs or any(e not in ev.ENVS for e in envs):
+        raise InputError(f"--envs: expected letters from 'abcde', got {envs!r}")
+    results, missing = ev.table1(tuple(envs), fast, log=lambda m: typer.echo(m, err=True))
+    cpu = platform.processor() or platform.machine()
+    header = [
+        "# Table I reproduction" + (" (fast mode: few samples, not a result)" if fast else ""),
+        "",
+        f"- command: `gdnplan reproduce table1{' --fast' if fast else ''} --envs {envs}`",
+        f"- date: {datetime.datetime.now().isoformat(timespec='seconds')}",
+        f"- machine: {platform.node()}, {cpu}, {os.cpu_count()} cores (shared), "
+        f"{platform.python_version()}",
+        f"- missing weights: {', '.join(missing) if missing else 'none'}",
+        "",
+        "",
+    ]
+    text = "\n".join(header) + ev.table1_markdown(results) + "\n"
+    typer.echo(text)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, out)
+    if figures is not None:
+        for path in ev.table1_figures(results, figures):
+            typer.echo(f"wrote {path}", err=True)
+
+
+@app.command("field")
+def field_command(
+    env: str = typer.Option("a", help="A 2-DoF environment (a or b)."),
+    out: Path = typer.Option(Path("field.png"), help="Output PNG."),
+    grid: int = typer.Option(101, help="Grid points per joint."),
+) -> None:
+    """The paper's Fig. 5: distance fields over (q1, q2) from coal, DiffCo and GraphDistNet."""
+    from .evaluate import fig5
+    from .viz import save_figure
+
+    save_figure(fig5(env, grid), out)
+    typer.echo(f"wrote {out}")
+
+
 def main() -> None:
     """Console entry point: run the app, turning GdnplanError into one line and exit code 2."""
     try:

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
@@ -248,15 +248,17 @@ def evaluate_model(
     n_grad: int = 2000,
     ds: Dataset | None = None,
     margin: float = DEFAULT_MARGIN,
+    repeats: int = 3,
 ) -> Result:
     """Time, MAE, AUC and ACD of one model on the first n test samples of ``env``.
 
-    The time is the wall time of ``distance`` over the whole batch (per obstacle set where the
-    model has no ``predict_dataset``); gradients are taken on the first ``n_grad`` samples.
+    The time is the fastest of ``repeats`` wall times of ``distance`` over the whole batch (per
+    obstacle set where the model has no ``predict_dataset``); gradients are taken on the first
+    ``n_grad`` samples.
     Models with ``is_distance = False`` (scores, e.g. DiffCo) get no MAE.
     """
     ds = test_set(env, n) if ds is None else ds.subset(slice(0, n))
-    (d_hat, _), seconds = timed(lambda: predict(model, ds, grad=False))
+    (d_hat, _), seconds = timed(lambda: predict(model, ds, grad=False), repeats)
     _, g_hat = predict(model, ds.subset(slice(0, min(n_grad, len(ds)))), grad=True)
     reach = ds.scene(0).robot.reach
     return evaluate_predictions(
@@ -269,3 +271,282 @@ def evaluate_model(
         reach,
         margin,
     )
+
+
+# -------------------------------------------------------------------- Table I
+ROOT = Path(__file__).resolve().parent.parent
+WEIGHTS_DIR = ROOT / "weights"
+ENVS = ("a", "b", "c", "d", "e")
+DIFFCO_SOURCE = {"b": "a", "d": "c"}  # random env -> fixed env DiffCo is trained on (paper)
+
+# Paper Table I: (time s, MAE, AUC, ACD); None where the paper has "-" or N/A.
+PAPER: dict[str, dict[str, tuple]] = {
+    "a": {
+        "coal": (1.0653, None, None, None),
+        "DiffCo": (0.0048, None, 1.0000, 0.3575),
+        "ClearanceNet": (0.0009, 0.0082, 1.0000, 0.0255),
+        "GraphDistNet": (0.0115, 0.0031, 1.0000, 0.0054),
+    },
+    "b": {
+        "coal": (1.1822, None, None, None),
+        "DiffCo (w/o AL)": (0.0054, None, 0.5031, 1.0270),
+        "DiffCo (w/ AL)": (2058.2, None, 0.9948, 0.4221),
+        "ClearanceNet": (0.0009, 0.1732, 0.9986, 0.2853),
+        "GraphDistNet": (0.0115, 0.0390, 0.9999, 0.1748),
+    },
+    "c": {
+        "coal": (3.1573, None, None, None),
+        "DiffCo": (0.0740, None, 0.9843, 0.3202),
+        "ClearanceNet": (0.0012, 0.2360, 0.9111, 0.5933),
+        "GraphDistNet": (0.0574, 0.0253, 0.9990, 0.1458),
+    },
+    "d": {
+        "coal": (4.4467, None, None, None),
+        "DiffCo (w/o AL)": (0.0742, None, 0.5239, 0.9450),
+        "DiffCo (w/ AL)": (75129.5, None, 0.9798, 0.3968),
+        "ClearanceNet": (0.0012, 0.7725, 0.5691, 0.9491),
+        "GraphDistNet": (0.0546, 0.1614, 0.9842, 0.4152),
+    },
+    "e": {
+        "coal": (6.8432, None, None, None),
+        "DiffCo (w/o AL)": (0.0350, None, 0.5200, 0.9612),
+        "DiffCo (w/ AL)": (None, None, None, None),  # out of memory in the paper
+        "ClearanceNet": (0.0011, 0.7479, 0.8882, 0.9767),
+        "GraphDistNet": (0.1251, 0.2446, 0.9925, 0.8421),
+    },
+}
+PAPER_P = {"a": 6e-20, "b": 2e-12, "c": 6e-60, "d": 1e-10, "e": 3e-2}
+
+
+@dataclass(frozen=True)
+class TableSettings:
+    """Sizes of one Table I run.
+
+    Attributes:
+        n: held-out samples per environment (time, MAE, AUC).
+        n_grad: samples for the ACD.
+        diffco_train: DiffCo training configurations (2-DoF, 7-DoF).
+        al_scenes: test scenes DiffCo adapts to (active learning), per random environment.
+        al_queries: configurations evaluated in each adapted scene.
+    """
+
+    n: int = 5000
+    n_grad: int = 2000
+    diffco_train: tuple[int, int] = (3000, 5000)
+    al_scenes: int = 10
+    al_queries: int = 200
+
+    @classmethod
+    def fast(cls) -> TableSettings:
+        return cls(n=200, n_grad=100, diffco_train=(400, 600), al_scenes=1, al_queries=100)
+
+
+def load_graphdistnet(env: str) -> DistanceModel | None:
+    """GraphDistNet from ``weights/<env>.safetensors`` when it exists, else None."""
+    path = WEIGHTS_DIR / f"{env}.safetensors"
+    if not path.exists():
+        return None
+    from .train import load_weights
+
+    model = load_weights(path)
+    model.name = "GraphDistNet"
+    return model
+
+
+def load_clearancenet(env: str) -> DistanceModel | None:
+    """ClearanceNet from ``weights/clearancenet_<env>.safetensors`` when it exists, else None."""
+    from .models.clearancenet import load as load_cn
+
+    path = WEIGHTS_DIR / f"clearancenet_{env}.safetensors"
+    return load_cn(path) if path.exists() else None
+
+
+def diffco_rows(env: str, ds: Dataset, s: TableSettings) -> list[Result]:
+    """DiffCo on ``env``: the score for time and AUC, the fitted surrogate for the ACD.
+
+    Fixed environments (a, c) train on their own scene. Random ones (b, d, e) use a model
+    trained on a (b), c (d) or one e scene (e) as is ("w/o AL") and, on the scenes of the first
+    ``al_scenes`` test samples, after active learning ("w/ AL"); the latter's AUC and ACD pool
+    ``al_queries`` uniform configurations per adapted scene, and its time is the mean
+    adaptation time per scene × n (the paper adapts to each test scene).
+    """
+    from .models.diffco import DiffCo
+    from .scene import make_scene
+
+    source = make_scene(DIFFCO_SOURCE.get(env, env), seed=0)
+    n_train = s.diffco_train[0 if source.robot.dof == 2 else 1]
+    base = DiffCo.train(source, n=n_train, seed=0)
+    reach = source.robot.reach
+    grad_ds = ds.subset(slice(0, s.n_grad))
+    (d_hat, _), seconds = timed(lambda: predict(base, ds, grad=False), repeats=3)
+    _, g_hat = predict(base.fitted(), grad_ds, grad=True)
+    label = "DiffCo" if env in ("a", "c") else "DiffCo (w/o AL)"
+    rows = [evaluate_predictions(label, ds, d_hat, g_hat, seconds, False, reach)]
+    if env in ("a", "c"):
+        return rows
+    scores, grads, d_true, g_true, qs, adapt_time = [], [], [], [], [], 0.0
+    for i in range(min(s.al_scenes, len(ds))):
+        scene = ds.scene(i)
+        adapted, t = timed(lambda scene=scene, i=i: base.adapt(scene, seed=i))
+        adapt_time += t
+        q = scene.robot.sample(s.al_queries, seed=[7, i])
+        f, gf = signed_distance_and_grad(scene, q)
+        scores.append(adapted.distance(scene, q))
+        grads.append(adapted.fitted().distance_and_grad(scene, q)[1])
+        d_true.append(f)
+        g_true.append(gf)
+        qs.append(q)
+    pooled = Dataset(
+        env,
+        np.concatenate(qs),
+        np.zeros((0, 0, 2)),
+        np.zeros((0, 0, 0, 2)),
+        np.zeros((0, 0), np.int32),
+        np.concatenate(d_true),
+        np.concatenate(g_true),
+        np.zeros(0, np.int64),
+    )
+    per_scene = adapt_time / max(min(s.al_scenes, len(ds)), 1)
+    rows.append(
+        evaluate_predictions(
+            "DiffCo (w/ AL)",
+            pooled,
+            np.concatenate(scores),
+            np.concatenate(grads),
+            per_scene * len(ds),
+            False,
+            reach,
+        )
+    )
+    return rows
+
+
+def table1_env(env: str, s: TableSettings) -> tuple[list[Result], float | None]:
+    """All methods on one environment, and Welch's p of GraphDistNet vs ClearanceNet errors."""
+    ds = test_set(env, s.n)
+    (_, _), coal_s = timed(lambda: coal_predict(ds, grad=False))
+    rows = [Result("coal", env, len(ds), coal_s, None, None, float("nan"), None, 0, None, ds.d)]
+    rows += diffco_rows(env, ds, s)
+    learned = {}
+    for name, loader in (("ClearanceNet", load_clearancenet), ("GraphDistNet", load_graphdistnet)):
+        model = loader(env)
+        if model is not None:
+            learned[name] = evaluate_model(model, env, s.n, s.n_grad, ds=ds)
+            rows.append(replace(learned[name], method=name))
+    p = None
+    if len(learned) == 2:
+        p = welch_p_value(learned["GraphDistNet"].abs_error, learned["ClearanceNet"].abs_error)
+    return rows, p
+
+
+def _num(v: float | None, fmt: str) -> str:
+    return "–" if v is None or (isinstance(v, float) and np.isnan(v)) else format(v, fmt)
+
+
+def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> str:
+    """Markdown of Table I: ours beside the paper's numbers (paper in the ``paper`` columns)."""
+    head = (
+        "| env | method | time (s) | paper | MAE (m) [/reach] | paper | p (GDN vs CN) | paper "
+        "| AUC | paper | ACD [n] | paper |"
+    )
+    lines = [head, "|" + "---|" * 12]
+    for env, (rows, p) in results.items():
+        for r in rows:
+            pt, pm, pa, pc = PAPER[env].get(r.method, (None,) * 4)
+            learned = r.method in ("ClearanceNet", "GraphDistNet")
+            mae = (
+                "N/A"
+                if r.method.startswith("DiffCo")
+                else ("–" if r.mae is None else f"{r.mae:.4f} [{r.mae_reach:.4f}]")
+            )
+            lines.append(
+                f"| {env} | {r.method} | {r.seconds:.4g} | {_num(pt, '.5g')} | {mae} "
+                f"| {_num(pm, '.4f')} | {_num(p, '.1e') if learned else ''} "
+                f"| {_num(PAPER_P[env], '.0e') if learned else ''} "
+                f"| {_num(r.auc, '.4f')} | {_num(pa, '.4f')} "
+                f"| {_num(r.acd, '.4f')}{f' [{r.n_grad}]' if r.acd is not None else ''} "
+                f"| {_num(pc, '.4f')} |"
+            )
+    return "\n".join(lines)
+
+
+def table1(envs: tuple[str, ...] = ENVS, fast: bool = False, log=print):
+    """Run Table I; returns {env: (rows, p)}. ``fast`` uses :meth:`TableSettings.fast`."""
+    s = TableSettings.fast() if fast else TableSettings()
+    out = {}
+    for env in envs:
+        out[env] = table1_env(env, s)
+        log(f"env {env}: " + ", ".join(r.method for r in out[env][0]))
+    missing = [
+        f"{name} {env}"
+        for env in envs
+        for name, path in (("ClearanceNet", f"clearancenet_{env}"), ("GraphDistNet", env))
+        if not (WEIGHTS_DIR / f"{path}.safetensors").exists()
+    ]
+    return out, missing
+
+
+def detour_path(
+    scene,
+    start: np.ndarray,
+    goal: np.ndarray,
+    clearance: float = 0.05,
+    steps: int = 200,
+    waypoints: int = 60,
+) -> np.ndarray:
+    """A joint path (T, dof) from start to goal pushed out of collision along coal's gradient.
+
+    Starts from the straight line and moves every waypoint closer than ``clearance`` (m) by
+    0.05 rad along ∂f/∂q, then re-spaces the path evenly, ``steps`` times (for Fig. 5 only).
+    """
+    q = np.linspace(start, goal, waypoints)
+    for _ in range(steps):
+        d, g = signed_distance_and_grad(scene, q[1:-1])
+        push = (d < clearance)[:, None] * g / np.maximum(np.linalg.norm(g, axis=1), 1e-9)[:, None]
+        q[1:-1] += 0.05 * push
+        arc = np.r_[0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
+        t = np.linspace(0, arc[-1], waypoints)
+        q = np.stack([np.interp(t, arc, q[:, j]) for j in range(q.shape[1])], 1)
+    return q
+
+
+def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000):
+    """The paper's Fig. 5 for a 2-DoF environment: coal, DiffCo (score) and GraphDistNet fields.
+
+    Returns the matplotlib Figure; GraphDistNet is left out when its weights are missing.
+    """
+    from .models import CoalModel
+    from .models.diffco import DiffCo
+    from .scene import make_scene
+    from .viz import distance_field, field_figure
+
+    scene = make_scene(env, seed=0)
+    fields = {"coal f (m)": distance_field(CoalModel(), scene, grid)}
+    fields["DiffCo score −s"] = distance_field(DiffCo.train(scene, n=diffco_train), scene, grid)
+    gdn = load_graphdistnet(env)
+    if gdn is not None:
+        fields["GraphDistNet d̂ (m)"] = distance_field(gdn, scene, grid)
+    path = detour_path(scene, np.array([1.3, 1.5]), np.array([1.3, -2.6]))
+    return field_figure(scene, fields, path)
+
+
+def table1_figures(results: dict[str, tuple[list[Result], float | None]], out_dir: Path) -> list:
+    """ROC curves and predicted-vs-true scatter plots of a Table I run, written as PNGs."""
+    from .viz import roc_figure, save_figure, scatter_figure
+
+    curves, points = {}, {}
+    for env, (rows, _) in results.items():
+        truth = next(r.score for r in rows if r.method == "coal")
+        curves[env] = {
+            r.method: (*roc_curve(-r.score, truth <= DEFAULT_MARGIN), r.auc)
+            for r in rows
+            if r.method != "coal" and "w/ AL" not in r.method
+        }
+        points[env] = {
+            r.method: (truth[:1000], r.score[:1000]) for r in rows if r.abs_error is not None
+        }
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = [out_dir / "table1_roc.png", out_dir / "table1_scatter.png"]
+    save_figure(roc_figure(curves), paths[0])
+    save_figure(scatter_figure(points), paths[1])
+    return paths

@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon as PolygonPatch
 
 from .distance import witness
+from .errors import InputError
 from .scene import Scene
 
 ROBOT_COLOR = "tab:red"
@@ -126,3 +127,98 @@ def animate_paths(
     tmp = out.with_name(f".{out.name}.tmp.gif")
     anim.save(tmp, writer=PillowWriter(fps=fps))
     os.replace(tmp, out)
+
+
+# -------------------------------------------------------------------- Table I figures
+def distance_field(
+    model, scene: Scene, n: int = 101, lim: float = np.pi
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A 2-DoF model's value over the grid (q1, q2) ∈ [−lim, lim]²: (q1 (n,), q2 (n,), D (n, n)).
+
+    ``D[i, j]`` is the value at (q1[j], q2[i]) (m for distances, a score for DiffCo).
+    """
+    if scene.robot.dof != 2:
+        raise InputError(f"scene: the field needs a 2-DoF robot, got {scene.robot.dof} joints")
+    axis = np.linspace(-lim, lim, n)
+    g1, g2 = np.meshgrid(axis, axis)
+    values = model.distance(scene, np.stack([g1.ravel(), g2.ravel()], 1))
+    return axis, axis, values.reshape(n, n)
+
+
+def end_effector(robot, q: np.ndarray) -> np.ndarray:
+    """(T, 2) midpoint of the last link's two nodes farthest from its joint (the arm's tip)."""
+    last = np.flatnonzero(robot.node_polygon == robot.n_links - 1)
+    lever = np.linalg.norm(robot.nodes0[last] - robot.chain.joint_origins[-1], axis=1)
+    tip = last[np.argsort(lever)[-2:]]
+    return robot.node_positions(q)[:, tip].mean(1)
+
+
+def field_figure(
+    scene: Scene,
+    fields: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
+    path_q: np.ndarray | None = None,
+) -> Figure:
+    """The paper's Fig. 5: the scene with the arm's trail, then one panel per field.
+
+    Each field panel shows the value (blue = collision side, red = free side, centred on the
+    zero level) with contour lines, the zero level in black and the joint path ``path_q``
+    (T, 2) in green.
+    """
+    fig = Figure(figsize=(4.2 * (len(fields) + 1), 4.2))
+    ax = fig.add_subplot(1, len(fields) + 1, 1)
+    draw_scene(ax, scene, None)
+    if path_q is not None:
+        for q in path_q[:: max(len(path_q) // 8, 1)]:
+            draw_polygons(ax, scene.robot.link_polygons(q), ROBOT_COLOR, alpha=0.15)
+        tip = end_effector(scene.robot, path_q)
+        ax.plot(tip[:, 0], tip[:, 1], "g-", linewidth=2)
+    ax.set_title(f"({chr(97)}) env {scene.name}: arm trail")
+    for k, (name, (q1, q2, values)) in enumerate(fields.items(), start=2):
+        ax = fig.add_subplot(1, len(fields) + 1, k)
+        top = float(np.max(np.abs(values)))
+        ax.contourf(q1, q2, values, levels=30, cmap="RdBu_r", vmin=-top, vmax=top)
+        ax.contour(q1, q2, values, levels=15, colors="k", linewidths=0.4, alpha=0.5)
+        ax.contour(q1, q2, values, levels=[0.0], colors="k", linewidths=1.5)
+        if path_q is not None:
+            ax.plot(path_q[:, 0], path_q[:, 1], "g-", linewidth=2)
+        ax.set_xlabel("q1 (rad)")
+        ax.set_ylabel("q2 (rad)")
+        ax.set_aspect("equal")
+        ax.set_title(f"({chr(96 + k)}) {name}")
+    fig.tight_layout()
+    return fig
+
+
+def roc_figure(curves: dict[str, dict[str, tuple[np.ndarray, np.ndarray, float]]]) -> Figure:
+    """ROC curves, one panel per environment: ``curves[env][method] = (fpr, tpr, auc)``."""
+    fig = Figure(figsize=(3.6 * len(curves), 3.6))
+    for k, (env, methods) in enumerate(curves.items(), start=1):
+        ax = fig.add_subplot(1, len(curves), k)
+        for method, (fpr, tpr, auc) in methods.items():
+            ax.plot(fpr, tpr, label=f"{method} ({auc:.4f})")
+        ax.plot([0, 1], [0, 1], "k:", linewidth=0.8)
+        ax.set_xlabel("false-positive rate")
+        ax.set_ylabel("true-positive rate")
+        ax.set_title(f"env {env}: collision (f ≤ 0)")
+        ax.legend(fontsize=7, loc="lower right")
+        ax.set_aspect("equal")
+    fig.tight_layout()
+    return fig
+
+
+def scatter_figure(points: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]) -> Figure:
+    """Predicted vs coal distance, one panel per environment: ``points[env][method] = (f, d̂)``."""
+    fig = Figure(figsize=(3.6 * len(points), 3.6))
+    for k, (env, methods) in enumerate(points.items(), start=1):
+        ax = fig.add_subplot(1, len(points), k)
+        lo, hi = np.inf, -np.inf
+        for method, (true, pred) in methods.items():
+            ax.scatter(true, pred, s=2, alpha=0.4, label=method)
+            lo, hi = min(lo, true.min(), pred.min()), max(hi, true.max(), pred.max())
+        ax.plot([lo, hi], [lo, hi], "k--", linewidth=0.8)
+        ax.set_xlabel("coal f (m)")
+        ax.set_ylabel("predicted d̂ (m)")
+        ax.set_title(f"env {env}")
+        ax.legend(fontsize=7, markerscale=4)
+    fig.tight_layout()
+    return fig

@@ -65,3 +65,17 @@ def test_coal_scores_perfectly_on_random_env():
     res = ev.evaluate_model(gp.CoalModel(), "b", n=60, n_grad=30, ds=ds)
     assert res.mae == pytest.approx(0, abs=1e-12) and res.acd == pytest.approx(0, abs=1e-9)
     assert res.auc == 1.0 and res.n_grad == 30 and res.seconds > 0
+
+
+def test_reproduce_table1_fast_writes_markdown(tmp_path):
+    from typer.testing import CliRunner
+
+    from gdnplan.cli import app
+
+    out = tmp_path / "t.md"
+    res = CliRunner().invoke(
+        app, ["reproduce", "table1", "--fast", "--envs", "a", "--out", str(out)]
+    )
+    assert res.exit_code == 0, res.output
+    text = out.read_text()
+    assert "| a | coal |" in text and "| a | DiffCo |" in text and "machine:" in text

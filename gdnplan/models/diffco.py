@@ -229,6 +229,13 @@ class DiffCo:
             out[s : s + CHUNK] = self.kernel.matrix(feats[s : s + CHUNK], sf) @ self.weights
         return out
 
+    def predict_dataset(self, ds, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        """A dataset's samples in one pass (DiffCo ignores their obstacles, see above)."""
+        scene = Scene(self.kernel.robot, ())
+        if grad:
+            return self.distance_and_grad(scene, ds.q)
+        return self.distance(scene, ds.q), None
+
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)) the value and its exact gradient through the node Jacobians."""
         q = scene.robot.check_q(q)
