@@ -1,0 +1,111 @@
+"""The fetch scene: storage with an entrance, stick, free grasp/lift/home/out configurations."""
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from shapely.geometry import Point, Polygon, box
+
+import gdnplan as gp
+from gdnplan import ur5e as U
+from gdnplan.geometry import is_convex
+from gdnplan.scene import scene_from_config
+
+PROBLEMS = Path(__file__).resolve().parent.parent / "problems"
+CONFIGS = ("q_grasp", "q_lift", "q_home", "q_out")
+
+
+def polygon(robot, q, name):
+    return robot.link_polygons(q)[[p.name for p in robot.polygons].index(name)]
+
+
+def check_fetch(seed: int) -> None:
+    """Every stated property of a fetch scene, checked with coal and shapely."""
+    scene = gp.make_scene("fetch", seed=seed)
+    held = gp.make_scene("fetch", seed=seed, gripper="holding")
+    info, layout = scene.info, scene.info["layout"]
+    stick = info["stick"]
+    # obstacles: table, storage (non-convex, open at the entrance), stick while not held
+    assert len(scene.obstacles) == 3 and np.allclose(scene.obstacles[2], stick)
+    assert len(held.obstacles) == 2 and held.robot.info["gripper"] == "holding"
+    assert held.robot.info["stick_length"] == layout.stick_length
+    storage = Polygon(info["storage"])
+    assert storage.is_valid and not is_convex(info["storage"])
+    front, e0, e1 = info["entrance"]
+    assert not storage.contains(Point(front + layout.wall / 2, (e0 + e1) / 2))  # the opening
+    assert storage.contains(Point(front + layout.wall / 2, e1 + 0.005))  # front wall above it
+    assert Polygon(stick).distance(storage) == pytest.approx(0.0, abs=1e-12)  # lies on its shelf
+    inner = box(front + layout.wall, layout.floor, front + layout.depth - layout.wall, layout.top)
+    assert inner.contains(Polygon(stick))
+
+    q = np.array([info[k] for k in CONFIGS])
+    assert scene.robot.within_limits(q).all()
+    d_open, d_held = gp.signed_distance(scene, q), gp.signed_distance(held, q)
+    assert d_open[0] >= U.MIN_CLEARANCE and d_open[2] >= U.MIN_CLEARANCE  # grasp, home
+    assert d_held[1] >= U.MIN_CLEARANCE and d_held[3] >= U.MIN_CLEARANCE  # lift, out
+    # grasp: gripper horizontal into the box, fingers above and below the stick's near end
+    np.testing.assert_allclose(
+        U.tcp_pose(scene.robot, info["q_grasp"]), info["grasp_tcp"], atol=1e-9
+    )
+    upper = Polygon(polygon(scene.robot, info["q_grasp"], "finger_left"))
+    lower = Polygon(polygon(scene.robot, info["q_grasp"], "finger_right"))
+    near_end = box(stick[0, 0], stick[0, 1], stick[0, 0] + 0.02, stick[2, 1])
+    assert upper.bounds[1] > stick[2, 1] and lower.bounds[3] < stick[0, 1]
+    assert upper.bounds[0] < near_end.bounds[0] and upper.bounds[2] > near_end.bounds[2]
+    assert upper.bounds[0] > front  # the fingers are inside the box
+    # closing the gripper makes the stick part of the robot, exactly where it lay
+    np.testing.assert_allclose(
+        np.sort(polygon(held.robot, info["q_grasp"], "stick"), 0), np.sort(stick, 0), atol=1e-9
+    )
+    # out: the held stick is clear of the storage's outline (above it)
+    out_stick = Polygon(polygon(held.robot, info["q_out"], "stick"))
+    assert out_stick.distance(Polygon(storage.exterior).convex_hull) > 0.05
+
+
+def test_canonical_fetch():
+    check_fetch(0)
+    scene = gp.make_scene("fetch")
+    assert scene.info["layout"] == U.CANONICAL_FETCH
+    assert scene.info["stick_length"] == 0.25 and scene.info["stick_width"] == 0.03
+
+
+@pytest.mark.parametrize("seed", [3, 11])
+def test_random_fetch_is_valid_and_seeded(seed):
+    check_fetch(seed)
+    a, b = gp.make_scene("fetch", seed=seed), gp.make_scene("fetch", seed=seed)
+    assert a.info["layout"] == b.info["layout"] != U.CANONICAL_FETCH
+
+
+def test_random_fetch_benchmark_layouts_differ():
+    layouts = [gp.make_scene("fetch", seed=s).info["layout"] for s in range(1, 21)]
+    lengths = [lay.stick_length for lay in layouts]
+    assert len(set(lengths)) == 20 and min(lengths) >= 0.15 and max(lengths) <= 0.30
+    assert np.ptp([lay.front for lay in layouts]) > 0.1
+    assert np.ptp([lay.entrance[0] for lay in layouts]) > 0.1
+
+
+def test_fetch_errors():
+    with pytest.raises(gp.UnknownNameError, match="gripper"):
+        gp.make_scene("fetch", gripper="bogus")
+    with pytest.raises(gp.InfeasibleProblemError, match="max_tries"):
+        gp.make_scene("fetch", seed=5, max_tries=0)
+
+
+@pytest.mark.parametrize("name", ["fetch_reach", "fetch_bring_out", "planar2_square", "planar7_d"])
+def test_problem_files_are_valid(name):
+    cfg = tomllib.loads((PROBLEMS / f"{name}.toml").read_text())
+    scene = scene_from_config(cfg)
+    q = np.array([cfg["start"]["q"], cfg["goal"]["q"]])
+    assert scene.robot.within_limits(q).all()
+    assert (gp.signed_distance(scene, q) > cfg["options"]["margin"]).all()
+    if name.startswith("fetch"):
+        keys = ("q_home", "q_grasp") if name == "fetch_reach" else ("q_lift", "q_out")
+        np.testing.assert_allclose(q, [scene.info[k] for k in keys], atol=1e-6)
+        assert scene.robot.info["gripper"] == cfg["robot"]["gripper"] == scene.info["gripper"]
+
+
+def test_plot(tmp_path):
+    scene = gp.make_scene("fetch")
+    U.plot_fetch(scene, scene.info["q_grasp"], str(tmp_path / "fetch.png"))
+    assert (tmp_path / "fetch.png").stat().st_size > 10_000
