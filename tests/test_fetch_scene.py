@@ -85,6 +85,13 @@ def test_random_fetch_benchmark_layouts_differ():
     assert np.ptp([lay.entrance[0] for lay in layouts]) > 0.1
 
 
+def test_unreachable_layout_is_rejected():
+    from dataclasses import replace
+
+    assert U.fetch_configurations(U.CANONICAL_FETCH) is not None
+    assert U.fetch_configurations(replace(U.CANONICAL_FETCH, front=1.2)) is None  # out of reach
+
+
 def test_fetch_errors():
     with pytest.raises(gp.UnknownNameError, match="gripper"):
         gp.make_scene("fetch", gripper="bogus")
