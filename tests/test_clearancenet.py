@@ -51,8 +51,8 @@ def test_gradient_matches_finite_differences(env):
 
 
 def test_short_training_beats_constant_and_round_trips(tmp_path):
-    ds = make_shard("b", 0, 0, 1000)
-    model = cn.train("b", ds, cn.ClearanceNetConfig.for_env("b", hidden=(64, 64)), epochs=12)
+    ds = make_shard("b", 0, 0, 1500)
+    model = cn.train("b", ds, cn.ClearanceNetConfig.for_env("b", hidden=(64, 64)), epochs=15)
     test = make_shard("b", 1, 0, 300)
     d, g = predict(model, test, grad=True)
     assert np.mean(np.abs(d - test.d)) < 0.8 * np.mean(np.abs(test.d - np.median(ds.d)))
