@@ -9,7 +9,7 @@ from .errors import (
     ProblemFileError,
     UnknownNameError,
 )
-from .models import CoalModel, DistanceModel
+from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot, load_robot, robot_names
 from .scene import Scene, make_scene, scene_names
 
@@ -23,6 +23,7 @@ __all__ = [
     "Robot",
     "Scene",
     "UnknownNameError",
+    "load_model",
     "load_robot",
     "make_scene",
     "robot_names",

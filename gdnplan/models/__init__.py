@@ -7,11 +7,14 @@ Planners, the CasADi bridge and the evaluation take any :class:`DistanceModel`.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from ..distance import signed_distance, signed_distance_and_grad
+from ..errors import InputError, UnknownNameError
 from ..scene import Scene
 
 
@@ -42,4 +45,21 @@ class CoalModel:
         return signed_distance_and_grad(scene, q)
 
 
-__all__ = ["CoalModel", "DistanceModel"]
+def load_model(path: Path | str) -> DistanceModel:
+    """Load a trained model: ``path`` (safetensors weights) and its JSON card beside it.
+
+    The card's ``"model"`` field selects the class (``"graphdistnet"``).
+    """
+    path = Path(path)
+    card = path.with_suffix(".json")
+    if not card.exists():
+        raise InputError(f"model: card {card} not found; weights need their JSON card beside them")
+    kind = json.loads(card.read_text()).get("model")
+    if kind == "graphdistnet":
+        from .graphdistnet import load_graphdistnet
+
+        return load_graphdistnet(path)
+    raise UnknownNameError(f"model: unknown model type {kind!r} in {card.name}")
+
+
+__all__ = ["CoalModel", "DistanceModel", "load_model"]

@@ -1,0 +1,381 @@
+"""GraphDistNet (paper §IV): message passing between a robot graph and an obstacle graph.
+
+Notation (one sample): nodes i of the union graph G_ro = G_r ∪ G_o with coordinates x_i⁽⁰⁾
+(normalised: (p − origin) / scale, scale = the arm's reach) and features x_i⁽ᵏ⁾ ∈ R^{d_h}.
+Layer k = 0 … K − 1 updates every node with its ring neighbours N(i) = {prev(i), next(i)} and
+one cross-graph partner j_c:
+
+    x_i⁽ᵏ⁺¹⁾ = Σ_{j ∈ N(i) ∪ {i}} h_k( z_j⁽ᵏ⁾ − z_i⁽ᵏ⁾ ‖ z̄_i⁽ᵏ⁾ − z_i⁽ᵏ⁾ ),
+    z_i⁽⁰⁾ = x_i⁽⁰⁾,  z_i⁽ᵏ⁾ = (x_i⁽⁰⁾ ‖ x_i⁽ᵏ⁾),                            (Eq. 2, 5)
+
+h_k an MLP R^4 → R^{d_h} (k = 0), R^{2 d_h + 4} → R^{d_h} (k > 0). The cross term z̄_i:
+
+* ``cross="argmax"`` (the paper): z̄_i = z_{j_c} with j_c uniform random over the other graph at
+  k = 0, and j_c = argmax_j a⁽ᵏ⁾ᵀ x_j⁽ᵏ⁾ over the other graph afterwards (one partner per graph).
+  d̂ is then random (k = 0) and jumps where the argmax switches.
+* ``cross="soft_knn"`` (planner default): a soft partner among the k + 1 nearest nodes c of the
+  other graph (squared distances d²_c in ascending order, d²_{k+1} the farthest of them):
+
+      z̄_i = Σ_c w_ic z_c,  w_ic ∝ φ_ic exp(−d²_ic / τ_k + a⁽ᵏ⁾ᵀ x_c⁽ᵏ⁾),  φ_ic = d²_{k+1} − d²_ic,
+
+  (no score at k = 0, τ_k learned). φ vanishes on the (k + 1)-th node, so a node entering or
+  leaving the candidate set does so with zero weight: d̂ is a deterministic, continuous
+  function of the node positions (and piecewise smooth).
+
+Readout (Eq. 9–11): per graph g ∈ {r, o} and layer k = 1 … K, α_i = softmax_{i∈g}(a⁽ᵏ⁾ᵀ x_i⁽ᵏ⁾),
+y_g⁽ᵏ⁾ = f(Σ_i α_i x_i⁽ᵏ⁾); y_g = max_k y_g⁽ᵏ⁾ element-wise; d̂ = scale · MLP(y_r ‖ y_o) (m).
+
+Implementation: dense padded tensors; the first linear layer of h_k is applied per node, not
+per edge, since W (z_j − z_i) = W z_j − W z_i: with W = [W_loc W_rel] and u = z W_locᵀ,
+v = z W_relᵀ (per node), the edge pre-activation is u_j − u_i + v̄_i − v_i + b.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+
+import numpy as np
+import torch
+from safetensors.torch import load_file
+from torch import nn
+
+from ..errors import InputError
+from ..graph import GraphBatch, obstacle_graph, robot_graph, scene_obstacles
+from ..scene import Scene
+
+PAD_DIST2 = 1e6  # squared distance (normalised units²) given to padded candidates
+
+
+@dataclass(frozen=True)
+class GraphDistNetConfig:
+    """Architecture, normalisation and loss options of GraphDistNet.
+
+    Attributes:
+        layers: K message-passing layers.
+        hidden: d_h, node feature size.
+        mlp: hidden widths of each h_k.
+        readout: hidden widths of the final MLP.
+        activation: ``"leaky_relu"`` (slope 0.2, the paper) or ``"silu"``.
+        cross: ``"argmax"`` (paper: random, then argmax partner) or ``"soft_knn"``.
+        cross_k: candidates k of ``soft_knn`` (k + 1 nearest nodes are looked at).
+        tau: initial temperature τ of ``soft_knn`` (normalised units², learned per layer).
+        max_edge: densify graph edges longer than this (m), or None.
+        grad_weight: weight λ of the gradient loss λ · (1 − cos(∂d̂/∂q, ∂f/∂q)).
+        scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
+        origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
+    """
+
+    layers: int = 4
+    hidden: int = 32
+    mlp: tuple[int, ...] = (32, 32, 32)
+    readout: tuple[int, ...] = (32, 32, 32)
+    activation: str = "leaky_relu"
+    cross: str = "soft_knn"
+    cross_k: int = 4
+    tau: float = 0.02
+    max_edge: float | None = None
+    grad_weight: float = 0.0
+    scale: float = 1.0
+    origin: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if self.activation not in ("leaky_relu", "silu"):
+            raise InputError(
+                f"activation: expected 'leaky_relu' or 'silu', got {self.activation!r}"
+            )
+        if self.cross not in ("argmax", "soft_knn"):
+            raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
+        if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
+            raise InputError("layers, hidden, cross_k and scale must be positive")
+
+    @classmethod
+    def faithful(cls, **changes) -> GraphDistNetConfig:
+        """The paper's network: random/argmax partners, LeakyReLU, distance loss only."""
+        return cls(cross="argmax", **changes)
+
+    @classmethod
+    def smooth(cls, **changes) -> GraphDistNetConfig:
+        """The planner default: deterministic, continuous soft k-nearest partners."""
+        return cls(cross="soft_knn", **changes)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> GraphDistNetConfig:
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise InputError(f"config: unknown GraphDistNet options {sorted(unknown)}")
+        data = dict(data)
+        for key in ("mlp", "readout", "origin"):
+            if key in data:
+                data[key] = tuple(data[key])
+        return cls(**data)
+
+    def with_(self, **changes) -> GraphDistNetConfig:
+        return replace(self, **changes)
+
+
+def _activation(name: str) -> nn.Module:
+    return nn.LeakyReLU(0.2) if name == "leaky_relu" else nn.SiLU()
+
+
+def mlp(sizes: list[int], activation: str) -> nn.Sequential:
+    """Linear layers of ``sizes`` with the activation between them (none after the last)."""
+    mods: list[nn.Module] = []
+    for i, (a, b) in enumerate(itertools.pairwise(sizes)):
+        mods.append(nn.Linear(a, b))
+        if i < len(sizes) - 2:
+            mods.append(_activation(activation))
+    return nn.Sequential(*mods)
+
+
+def masked_softmax(logits: torch.Tensor, mask: torch.Tensor, dim: int = -1) -> torch.Tensor:
+    """Softmax over ``dim`` with masked-out entries at zero weight."""
+    return torch.softmax(logits.masked_fill(~mask, -math.inf), dim)
+
+
+@dataclass(frozen=True)
+class Union:
+    """The union graph G_ro of a batch: N = N_r + N_o nodes (robot nodes first).
+
+    Attributes:
+        x0: (B, N, 2) normalised coordinates.
+        nbr: (B, N, 3) neighbour indices (prev, next, self).
+        mask: (B, N) real nodes.
+        n_robot: N_r.
+    """
+
+    x0: torch.Tensor
+    nbr: torch.Tensor
+    mask: torch.Tensor
+    n_robot: int
+
+
+class GraphDistNet(nn.Module):
+    """The network of :class:`GraphDistNetConfig`; ``forward(robot, obstacles) -> d̂ (B,)`` (m)."""
+
+    def __init__(self, config: GraphDistNetConfig):
+        super().__init__()
+        self.config = config
+        c = config
+        self.convs = nn.ModuleList()
+        for k in range(c.layers):
+            d_in = 2 if k == 0 else 2 + c.hidden  # size of z_i
+            self.convs.append(mlp([2 * d_in, *c.mlp, c.hidden], c.activation))
+        self.attention = nn.Parameter(torch.randn(c.layers, c.hidden) / math.sqrt(c.hidden))
+        self.log_tau = nn.Parameter(torch.full((c.layers,), math.log(c.tau)))
+        self.head = mlp([2 * c.hidden, *c.readout, 1], c.activation)
+        self.out_act = _activation(c.activation)
+
+    # ------------------------------------------------------------------ graph plumbing
+    def union(self, robot: GraphBatch, obstacles: GraphBatch) -> Union:
+        """Normalise coordinates and join both graphs (obstacle indices shifted by N_r)."""
+        c = self.config
+        origin = torch.as_tensor(c.origin, dtype=robot.nodes.dtype, device=robot.nodes.device)
+        x0 = (torch.cat([robot.nodes, obstacles.nodes], 1) - origin) / c.scale
+        n_r, n = robot.nodes.shape[1], robot.nodes.shape[1] + obstacles.nodes.shape[1]
+        prev = torch.cat([robot.prev, obstacles.prev + n_r], 1)
+        next = torch.cat([robot.next, obstacles.next + n_r], 1)
+        own = torch.arange(n, device=x0.device).expand(x0.shape[0], -1)
+        nbr = torch.stack([prev, next, own], -1)
+        return Union(x0, nbr, torch.cat([robot.mask, obstacles.mask], 1), n_r)
+
+    def candidates(self, g: Union) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Soft-kNN candidates of every node in the other graph.
+
+        Returns:
+            idx (B, N, C) candidate indices into the union, log φ (B, N, C) and d² (B, N, C),
+            C = min(k + 1, size of the larger graph); missing candidates have log φ = −∞.
+        """
+        n_r = g.n_robot
+        xr, xo = g.x0[:, :n_r], g.x0[:, n_r:]
+        d2 = torch.cdist(xr, xo).square()  # (B, N_r, N_o)
+        d2 = d2.masked_fill(~g.mask[:, None, n_r:], PAD_DIST2)
+        d2 = d2.masked_fill(~g.mask[:, :n_r, None], PAD_DIST2)
+        c = min(self.config.cross_k + 1, max(d2.shape[1:]))
+        out = []
+        for dist, offset in ((d2, n_r), (d2.transpose(1, 2), 0)):
+            kk = min(c, dist.shape[-1])
+            near, idx = torch.topk(dist, kk, dim=-1, largest=False)  # ascending
+            log_phi = (near[..., -1:] - near).clamp_min(1e-12).log()
+            if kk < c:  # a small other graph: pad with zero-weight candidates
+                pad = (0, c - kk)
+                near = nn.functional.pad(near, pad, value=PAD_DIST2)
+                log_phi = nn.functional.pad(log_phi, pad, value=-math.inf)
+                idx = nn.functional.pad(idx, pad)
+            out.append((idx + offset, log_phi, near))
+        return tuple(torch.cat(parts, 1) for parts in zip(*out, strict=True))
+
+    def partners_argmax(
+        self, g: Union, h: torch.Tensor | None, k: int, generator: torch.Generator | None
+    ) -> torch.Tensor:
+        """(B, N) paper partners: random at k = 0, else argmax of a⁽ᵏ⁾ᵀ x⁽ᵏ⁾ in the other graph."""
+        b, n = g.mask.shape
+        n_r = g.n_robot
+        valid_r = g.mask[:, :n_r].sum(1, keepdim=True)  # valid nodes come first in each graph
+        valid_o = g.mask[:, n_r:].sum(1, keepdim=True)
+        is_robot = torch.arange(n, device=g.mask.device) < n_r
+        if h is None:
+            u = torch.rand(b, n, generator=generator, device=g.mask.device)
+            pick_o = n_r + (u * valid_o).long().clamp_max(valid_o - 1)
+            pick_r = (u * valid_r).long().clamp_max(valid_r - 1)
+            return torch.where(is_robot, pick_o, pick_r)
+        score = (h @ self.attention[k - 1]).masked_fill(~g.mask, -math.inf)
+        best_r = score[:, :n_r].argmax(1, keepdim=True)
+        best_o = n_r + score[:, n_r:].argmax(1, keepdim=True)
+        return torch.where(is_robot, best_o, best_r)
+
+    def cross_weights(
+        self,
+        g: Union,
+        h: torch.Tensor | None,
+        k: int,
+        cand: tuple[torch.Tensor, torch.Tensor, torch.Tensor] | None,
+        generator: torch.Generator | None,
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Partners (B, N, C) and weights (B, N, C), Σ_c w = 1, of conv layer k (h = x⁽ᵏ⁾)."""
+        if self.config.cross == "argmax":
+            idx = self.partners_argmax(g, h, k, generator)[..., None]
+            return idx, torch.ones(idx.shape, dtype=g.x0.dtype, device=g.x0.device)
+        idx, log_phi, d2 = cand
+        logits = log_phi - d2 / self.log_tau[k].exp()
+        if h is not None:
+            score = h @ self.attention[k - 1]  # a⁽ᵏ⁾ scores x⁽ᵏ⁾, k ≥ 1
+            logits = logits + torch.gather(score, 1, idx.flatten(1)).view(idx.shape)
+        return idx, torch.softmax(logits, -1)
+
+    def edge_preactivation(
+        self, k: int, z: torch.Tensor, nbr: torch.Tensor, idx: torch.Tensor, w: torch.Tensor
+    ) -> torch.Tensor:
+        """First linear layer of h_k on every edge, computed per node.
+
+        Args:
+            z: (B, N, D) node inputs z_i.
+            nbr: (B, N, 3) neighbours (prev, next, self).
+            idx, w: (B, N, C) cross partners and weights.
+
+        Returns:
+            (B, N, 3, H): W_loc (z_j − z_i) + W_rel (Σ_c w_ic z_c − z_i) + b.
+        """
+        first = self.convs[k][0]
+        d = z.shape[-1]
+        u = z @ first.weight[:, :d].T  # (B, N, H)
+        v = z @ first.weight[:, d:].T
+        b, n, h = u.shape
+        u_j = torch.gather(u, 1, nbr.flatten(1)[..., None].expand(-1, -1, h)).view(b, n, 3, h)
+        v_c = torch.gather(v, 1, idx.flatten(1)[..., None].expand(-1, -1, h))
+        v_bar = (w[:, :, None] @ v_c.view(b, n, -1, h)).squeeze(2)  # Σ_c w_ic v_c
+        return u_j - u[:, :, None] + (v_bar - v + first.bias)[:, :, None]
+
+    def readout(self, g: Union, h: torch.Tensor, k: int) -> torch.Tensor:
+        """(B, 2 d_h): f(Σ α_i x_i⁽ᵏ⁾) for the robot graph, then the obstacle graph (k ≥ 1)."""
+        score = h @ self.attention[k - 1]
+        ys = []
+        for sl in (slice(0, g.n_robot), slice(g.n_robot, None)):
+            alpha = masked_softmax(score[:, sl], g.mask[:, sl])
+            ys.append(self.out_act((alpha[..., None] * h[:, sl]).sum(1)))
+        return torch.cat(ys, -1)
+
+    # ------------------------------------------------------------------ forward
+    def forward(
+        self, robot: GraphBatch, obstacles: GraphBatch, generator: torch.Generator | None = None
+    ) -> torch.Tensor:
+        """Estimated signed distance d̂ (B,) in metres.
+
+        Args:
+            robot: robot graphs (B, N_r) at the configurations (coordinates in m).
+            obstacles: obstacle graphs (B, N_o) (m).
+            generator: random source of the first-layer partners (``cross="argmax"`` only).
+        """
+        g = self.union(robot, obstacles)
+        cand = self.candidates(g) if self.config.cross == "soft_knn" else None
+        h = None
+        pooled = None
+        for k in range(self.config.layers):
+            z = g.x0 if h is None else torch.cat([g.x0, h], -1)
+            idx, w = self.cross_weights(g, h, k, cand, generator)
+            pre = self.edge_preactivation(k, z, g.nbr, idx, w)
+            h = self.convs[k][1:](pre).sum(2) * g.mask[..., None]
+            y = self.readout(g, h, k + 1)
+            pooled = y if pooled is None else torch.maximum(pooled, y)
+        return self.head(pooled).squeeze(-1) * self.config.scale
+
+
+class GraphDistNetModel:
+    """A trained GraphDistNet as a :class:`~gdnplan.models.DistanceModel`.
+
+    ∂d̂/∂q = Σ_n (∂d̂/∂p_n) ∂p_n/∂q: autograd on the robot node coordinates p_n (B, N, 2)
+    chained with the node Jacobians (B, N, 2, dof) of :class:`~gdnplan.graph.RobotGraph`.
+    Computation is float32 in chunks of ``chunk`` samples; results are float64.
+    """
+
+    name = "graphdistnet"
+
+    def __init__(self, net: GraphDistNet, card: dict | None = None, chunk: int = 256):
+        self.net = net.eval()
+        self.config = net.config
+        self.card = card or {}
+        self.chunk = chunk
+
+    def _graphs(self, scene: Scene):
+        graph = robot_graph(scene.robot, self.config.max_edge)
+        polys, sizes = scene_obstacles([scene])
+        obstacles = obstacle_graph(polys, sizes, self.config.max_edge)
+        return graph, obstacles
+
+    def _generator(self) -> torch.Generator | None:
+        return torch.Generator().manual_seed(0) if self.config.cross == "argmax" else None
+
+    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        """(B,) estimated signed distances (m) of q (B, dof) or (dof,)."""
+        q = scene.robot.check_q(q)
+        graph, obstacles = self._graphs(scene)
+        gen = self._generator()
+        out = []
+        with torch.inference_mode():
+            for s in range(0, len(q), self.chunk):
+                nodes = graph.positions(q[s : s + self.chunk])
+                rb = graph.batch(nodes)
+                ob = _repeat(obstacles, len(nodes))
+                out.append(self.net(rb, ob, gen).double().numpy())
+        return np.concatenate(out)
+
+    def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad)."""
+        q = scene.robot.check_q(q)
+        graph, obstacles = self._graphs(scene)
+        gen = self._generator()
+        ds, gs = [], []
+        for s in range(0, len(q), self.chunk):
+            nodes, jac = graph.positions_and_jacobians(q[s : s + self.chunk])
+            x = torch.tensor(nodes, dtype=torch.float32, requires_grad=True)
+            with torch.enable_grad():
+                d = self.net(graph.batch(x), _repeat(obstacles, len(nodes)), gen)
+                (dx,) = torch.autograd.grad(d.sum(), x)
+            ds.append(d.detach().double().numpy())
+            gs.append(np.einsum("bni,bnij->bj", dx.double().numpy(), jac))
+        return np.concatenate(ds), np.concatenate(gs)
+
+
+def _repeat(graph: GraphBatch, b: int) -> GraphBatch:
+    """A single graph (1, N) repeated B times (views, no copy)."""
+    parts = (graph.nodes, graph.prev, graph.next, graph.mask)
+    return GraphBatch(*(t.expand(b, *t.shape[1:]) for t in parts))
+
+
+def load_graphdistnet(path: Path | str) -> GraphDistNetModel:
+    """A :class:`GraphDistNetModel` from ``path`` (safetensors) and the JSON card beside it."""
+    path = Path(path)
+    card_path = path.with_suffix(".json")
+    if not path.exists() or not card_path.exists():
+        raise InputError(f"weights: {path} or its card {card_path.name} is missing")
+    card = json.loads(card_path.read_text())
+    net = GraphDistNet(GraphDistNetConfig.from_dict(card["config"]))
+    net.load_state_dict(load_file(str(path)))
+    return GraphDistNetModel(net, card)

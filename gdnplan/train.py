@@ -1,0 +1,445 @@
+"""Training and evaluation of GraphDistNet on the datasets of :mod:`gdnplan.data`.
+
+Loss per sample (distances normalised by the config's ``scale`` = reach):
+
+    L = ((d̂ − f) / scale)² + λ · (1 − cos(∂d̂/∂q, ∂f/∂q))      (λ = ``grad_weight``, 0 = paper)
+
+with ∂d̂/∂q = Σ_n (∂d̂/∂p_n) ∂p_n/∂q (node Jacobians). Adam, a validation split (10 % of
+train), learning rate halved after 3 epochs without improvement, early stopping after
+``patience`` epochs, an optional wall-clock budget. Each epoch writes a checkpoint (safetensors +
+JSON) in the run directory, so an interrupted run resumes where it stopped; the epoch order is
+a function of (seed, epoch), hence runs are deterministic on one device.
+
+Metrics (:func:`evaluate`, paper Table I), against coal labels on a held-out split:
+
+* MAE = mean |d̂ − f| (m), also as a fraction of the arm's reach;
+* AUC of the collision classifier d̂ ≤ margin vs f ≤ margin (Mann–Whitney rank formula);
+* ACD = mean (1 − cos(∂d̂/∂q, ∂f/∂q)) over samples where both gradients are non-zero.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+from safetensors.torch import load_file, save_file
+from scipy.stats import rankdata
+from tqdm import tqdm
+
+from .data import DATA_DIR, Dataset, load, split_dir
+from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph
+from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
+from .scene import make_scene
+
+ROOT = Path(__file__).resolve().parent.parent
+WEIGHTS_DIR = ROOT / "weights"
+RUNS_DIR = ROOT / "runs"
+
+
+@dataclass(frozen=True)
+class Tensors:
+    """A dataset as model-ready tensors (float32), built once.
+
+    Attributes:
+        q: (n, dof) float64 numpy joint angles.
+        nodes: (n, N_r, 2) robot node positions.
+        jac: (n, N_r, 2, dof) node Jacobians (float32).
+        obstacles: obstacle graphs of all samples.
+        d: (n,) coal signed distances.
+        grad: (n, dof) coal ∂f/∂q.
+    """
+
+    graph: RobotGraph
+    q: np.ndarray
+    nodes: torch.Tensor
+    jac: torch.Tensor
+    obstacles: GraphBatch
+    d: torch.Tensor
+    grad: torch.Tensor
+
+    def __len__(self) -> int:
+        return len(self.q)
+
+    def batch(self, rows: torch.Tensor, device: str) -> tuple[GraphBatch, GraphBatch]:
+        robot = self.graph.batch(self.nodes[rows], device=device)
+        return robot, self.obstacles.index(rows).to(device)
+
+
+def tensors(ds: Dataset, config: GraphDistNetConfig) -> Tensors:
+    """Robot nodes, Jacobians and obstacle graphs of a dataset (densified as configured)."""
+    graph = robot_graph(make_scene(ds.env).robot, config.max_edge)
+    nodes, jac = graph.positions_and_jacobians(ds.q)
+    return Tensors(
+        graph,
+        ds.q,
+        torch.as_tensor(nodes, dtype=torch.float32),
+        torch.as_tensor(jac, dtype=torch.float32),
+        obstacle_graph(ds.obstacles, ds.sizes, config.max_edge),
+        torch.as_tensor(ds.d, dtype=torch.float32),
+        torch.as_tensor(ds.grad, dtype=torch.float32),
+    )
+
+
+def forward_with_grad(
+    net: GraphDistNet,
+    robot: GraphBatch,
+    obstacles: GraphBatch,
+    jac: torch.Tensor,
+    create_graph: bool,
+    generator: torch.Generator | None = None,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """d̂ (B,) and ∂d̂/∂q (B, dof) = Σ_n ∂d̂/∂p_n · J_n with J (B, N_r, 2, dof)."""
+    x = robot.nodes.detach().requires_grad_(True)
+    with torch.enable_grad():
+        d = net(robot.with_nodes(x), obstacles, generator)
+        (dx,) = torch.autograd.grad(d.sum(), x, create_graph=create_graph)
+    return d, torch.einsum("bni,bnij->bj", dx, jac)
+
+
+def predict(
+    net: GraphDistNet, t: Tensors, chunk: int = 256, device: str = "cpu", grad: bool = True
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """d̂ (n,) and, with ``grad``, ∂d̂/∂q (n, dof) for every sample of ``t`` (float64)."""
+    net.eval()
+    gen = torch.Generator(device=device).manual_seed(0)
+    ds, gs = [], []
+    for s in range(0, len(t), chunk):
+        rows = torch.arange(s, min(s + chunk, len(t)))
+        robot, obstacles = t.batch(rows, device)
+        if grad:
+            d, g = forward_with_grad(net, robot, obstacles, t.jac[rows].to(device), False, gen)
+            gs.append(g.detach().double().cpu().numpy())
+        else:
+            with torch.inference_mode():
+                d = net(robot, obstacles, gen)
+        ds.append(d.detach().double().cpu().numpy())
+    return np.concatenate(ds), (np.concatenate(gs) if grad else None)
+
+
+def roc_auc(labels: np.ndarray, scores: np.ndarray) -> float:
+    """Area under the ROC curve of ``scores`` for binary ``labels`` (rank formula, ties averaged).
+
+    AUC = (Σ_{positives} rank − n₊(n₊ + 1)/2) / (n₊ n₋).
+    """
+    labels = np.asarray(labels, bool)
+    n_pos, n_neg = int(labels.sum()), int((~labels).sum())
+    if n_pos == 0 or n_neg == 0:
+        return float("nan")
+    ranks = rankdata(scores)
+    return float((ranks[labels].sum() - n_pos * (n_pos + 1) / 2) / (n_pos * n_neg))
+
+
+def mean_cosine_distance(g_hat: np.ndarray, g: np.ndarray) -> tuple[float, int]:
+    """Mean of 1 − cos(ĝ, g) over rows where both are non-zero, and how many rows counted."""
+    nh, ng = np.linalg.norm(g_hat, axis=1), np.linalg.norm(g, axis=1)
+    ok = (nh > 1e-12) & (ng > 1e-12)
+    cos = np.sum(g_hat[ok] * g[ok], 1) / (nh[ok] * ng[ok])
+    return float(np.mean(1 - cos)), int(ok.sum())
+
+
+def metrics(
+    d_hat: np.ndarray, g_hat: np.ndarray, d: np.ndarray, g: np.ndarray, reach: float, margin: float
+) -> dict:
+    """MAE (m, fraction of reach), AUC of d ≤ margin, ACD; see the module docstring."""
+    acd, n_acd = mean_cosine_distance(g_hat, g)
+    mae = float(np.mean(np.abs(d_hat - d)))
+    return {
+        "n": len(d),
+        "mae_m": mae,
+        "mae_reach": mae / reach,
+        "auc": roc_auc(d <= margin, -d_hat),
+        "acd": acd,
+        "acd_n": n_acd,
+        "collision_fraction": float(np.mean(d <= margin)),
+    }
+
+
+def evaluate(net: GraphDistNet, ds: Dataset, margin: float = 0.0, device: str = "cpu") -> dict:
+    """Table I metrics of ``net`` on a held-out split ``ds`` (all samples)."""
+    t = tensors(ds, net.config)
+    start = time.perf_counter()
+    d_hat, g_hat = predict(net, t, device=device)
+    elapsed = time.perf_counter() - start
+    out = metrics(d_hat, g_hat, ds.d, ds.grad, t.graph.robot.reach, margin)
+    out["seconds_per_sample_with_grad"] = elapsed / len(ds)
+    return out
+
+
+def git_sha() -> str:
+    try:
+        return subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=True
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def _save_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam, state: dict) -> None:
+    tensors = {f"net.{k}": v.contiguous() for k, v in net.state_dict().items()}
+    for i, s in enumerate(opt.state.values()):
+        for k, v in s.items():
+            tensors[f"opt.{i}.{k}"] = torch.as_tensor(v).contiguous()
+    best = state.pop("best_state", None)
+    if best is not None:
+        tensors.update({f"best.{k}": v.contiguous() for k, v in best.items()})
+    tmp = path.with_suffix(".tmp")
+    save_file(tensors, str(tmp))
+    os.replace(tmp, path)
+    _write_json(path.with_suffix(".json"), state)
+    if best is not None:
+        state["best_state"] = best
+
+
+def _load_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam) -> dict:
+    tensors = load_file(str(path))
+    net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
+    params = [p for g in opt.param_groups for p in g["params"]]
+    for i, p in enumerate(params):
+        keys = {k.split(".", 2)[2]: v for k, v in tensors.items() if k.startswith(f"opt.{i}.")}
+        if keys:
+            opt.state[p] = keys
+    state = json.loads(path.with_suffix(".json").read_text())
+    for g in opt.param_groups:
+        g["lr"] = state["lr"]
+    best = {k[5:]: v for k, v in tensors.items() if k.startswith("best.")}
+    state["best_state"] = best or None
+    return state
+
+
+def _write_json(path: Path, obj: dict) -> None:
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(obj, indent=2, default=float))
+    os.replace(tmp, path)
+
+
+def save_weights(net: GraphDistNet, card: dict, path: Path | str) -> Path:
+    """Write ``path`` (safetensors) and the JSON card beside it (config included)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    save_file({k: v.contiguous() for k, v in net.state_dict().items()}, str(tmp))
+    os.replace(tmp, path)
+    _write_json(path.with_suffix(".json"), {**card, "config": net.config.to_dict()})
+    return path
+
+
+load_weights = load_graphdistnet  # weights/<env>.safetensors -> GraphDistNetModel
+
+
+def train(
+    env: str,
+    config: GraphDistNetConfig | None = None,
+    name: str = "smooth",
+    n_train: int | None = None,
+    batch: int = 256,
+    lr: float = 1e-3,
+    epochs: int = 200,
+    patience: int = 10,
+    time_budget: float | None = None,
+    seed: int = 0,
+    device: str = "cpu",
+    data_root: Path | str = DATA_DIR,
+    out: Path | str | None = None,
+    run_dir: Path | str | None = None,
+) -> dict:
+    """Train GraphDistNet on ``data/<env>/train``, evaluate on ``data/<env>/test``, save weights.
+
+    Args:
+        env: environment name (its splits must exist, see :func:`gdnplan.data.generate`).
+        config: architecture (``scale`` and ``origin`` are set from the robot).
+        name: run name (``runs/<env>-<name>``).
+        n_train: use only the first n training samples (incl. the 10 % validation part).
+        time_budget: stop after this many seconds of training (s).
+        device: ``"cpu"`` or ``"cuda"``.
+        out: weights path (default ``weights/<env>.safetensors``; the card goes beside it).
+
+    Returns:
+        The card written beside the weights (config, data, training log, test metrics).
+    """
+    robot = make_scene(env).robot
+    config = (config or GraphDistNetConfig.smooth()).with_(
+        scale=round(robot.reach, 6), origin=tuple(float(v) for v in robot.chain.joint_origins[0])
+    )
+    run_dir = Path(run_dir or RUNS_DIR / f"{env}-{name}")
+    run_dir.mkdir(parents=True, exist_ok=True)
+    out = Path(out or WEIGHTS_DIR / f"{env}.safetensors")
+    torch.manual_seed(seed)
+    full = load(split_dir(env, "train", data_root), n_train)
+    order = np.random.default_rng(seed).permutation(len(full))
+    n_val = max(len(full) // 10, 1)
+    train_t = tensors(full.subset(order[n_val:]), config)
+    val_t = tensors(full.subset(order[:n_val]), config)
+    net = GraphDistNet(config).to(device)
+    opt = torch.optim.Adam(net.parameters(), lr=lr)
+    ckpt = run_dir / "checkpoint.safetensors"
+    state = {"epoch": 0, "lr": lr, "best": math.inf, "stale": 0, "plateau": 0, "log": []}
+    state["best_state"] = None
+    if ckpt.exists():
+        state = _load_checkpoint(ckpt, net, opt)
+        print(f"resumed {run_dir} at epoch {state['epoch']}")
+    trained = sum(e["seconds"] for e in state["log"])
+    n = len(train_t)
+    while state["epoch"] < epochs and state["stale"] < patience:
+        if time_budget is not None and trained >= time_budget:
+            break
+        epoch = state["epoch"]
+        net.train()
+        perm = torch.as_tensor(np.random.default_rng([seed, epoch]).permutation(n))
+        gen = torch.Generator(device=device).manual_seed(seed * 100_003 + epoch)
+        start = time.perf_counter()
+        total = 0.0
+        bar = tqdm(
+            range(0, n, batch), desc=f"{env}-{name} epoch {epoch}", leave=False, mininterval=5
+        )
+        for s in bar:
+            rows = perm[s : s + batch]
+            robot_b, obst_b = train_t.batch(rows, device)
+            d = train_t.d[rows].to(device)
+            if config.grad_weight > 0:
+                jac = train_t.jac[rows].to(device)
+                d_hat, g_hat = forward_with_grad(net, robot_b, obst_b, jac, True, gen)
+                g = train_t.grad[rows].to(device)
+                ok = (g.norm(dim=1) > 1e-9).float()
+                cos = torch.nn.functional.cosine_similarity(g_hat, g, dim=1, eps=1e-9)
+                loss_g = ((1 - cos) * ok).sum() / ok.sum().clamp_min(1)
+            else:
+                d_hat, loss_g = net(robot_b, obst_b, gen), torch.zeros((), device=device)
+            loss = ((d_hat - d) / config.scale).square().mean() + config.grad_weight * loss_g
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            total += float(loss.detach()) * len(rows)
+            bar.set_postfix(loss=f"{float(loss.detach()):.2e}", refresh=False)
+        seconds = time.perf_counter() - start
+        trained += seconds
+        val_hat, _ = predict(net, val_t, device=device, grad=False)
+        val_mae = float(np.mean(np.abs(val_hat - val_t.d.double().numpy())))
+        entry = {
+            "epoch": epoch,
+            "train_loss": total / n,
+            "val_mae_m": val_mae,
+            "lr": state["lr"],
+            "seconds": seconds,
+            "samples_per_s": n / seconds,
+        }
+        state["log"].append(entry)
+        print(json.dumps(entry))
+        if val_mae < state["best"]:
+            state.update(best=val_mae, stale=0, plateau=0)
+            state["best_state"] = {k: v.detach().clone() for k, v in net.state_dict().items()}
+        else:
+            state["stale"] += 1
+            state["plateau"] += 1
+            if state["plateau"] >= 3:
+                state["lr"] /= 2
+                state["plateau"] = 0
+                for g in opt.param_groups:
+                    g["lr"] = state["lr"]
+        state["epoch"] = epoch + 1
+        _save_checkpoint(ckpt, net, opt, state)
+    net.load_state_dict(state["best_state"])
+    plot_losses(state["log"], run_dir / "loss.png", f"{env}-{name}")
+    test = evaluate(net, load(split_dir(env, "test", data_root)), device=device)
+    log = state["log"]
+    card = {
+        "model": "graphdistnet",
+        "name": name,
+        "env": env,
+        "robot": robot.name,
+        "data": {
+            "train_dir": str(split_dir(env, "train", Path("data"))),
+            "train_seed": 0,
+            "n_train": n,
+            "n_val": len(val_t),
+            "test_seed": 1,
+            "n_test": test["n"],
+        },
+        "training": {
+            "seed": seed,
+            "batch": batch,
+            "lr": lr,
+            "epochs": len(log),
+            "best_val_mae_m": state["best"],
+            "seconds": sum(e["seconds"] for e in log),
+            "samples_per_s": float(np.mean([e["samples_per_s"] for e in log])),
+            "device": device,
+            "threads": torch.get_num_threads(),
+        },
+        "parameters": sum(p.numel() for p in net.parameters()),
+        "test": test,
+        "git_sha": git_sha(),
+    }
+    save_weights(net.cpu(), card, out)
+    return card
+
+
+def plot_losses(log: list[dict], path: Path, title: str) -> None:
+    """Training loss and validation MAE per epoch, as a PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 3.2))
+    epochs = [e["epoch"] for e in log]
+    ax.semilogy(epochs, [e["train_loss"] for e in log], label="train loss (normalised MSE)")
+    ax.semilogy(epochs, [e["val_mae_m"] for e in log], label="validation MAE (m)")
+    ax.set_xlabel("epoch")
+    ax.set_title(title)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+PRESETS = {"faithful": GraphDistNetConfig.faithful, "smooth": GraphDistNetConfig.smooth}
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m gdnplan.train --env d [--preset smooth] [--set key=value ...]``."""
+    p = argparse.ArgumentParser(description=main.__doc__)
+    p.add_argument("--env", required=True)
+    p.add_argument("--preset", default="smooth", choices=sorted(PRESETS))
+    p.add_argument("--name", default=None, help="run name (default: the preset)")
+    p.add_argument("--set", nargs="*", default=[], help="config overrides key=json_value")
+    p.add_argument("--n-train", type=int, default=None)
+    p.add_argument("--batch", type=int, default=256)
+    p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument("--epochs", type=int, default=200)
+    p.add_argument("--patience", type=int, default=10)
+    p.add_argument("--time-budget", type=float, default=None, help="seconds of training")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--device", default="cpu")
+    p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--out", default=None)
+    a = p.parse_args(argv)
+    torch.set_num_threads(a.threads)
+    overrides = {k: json.loads(v) for k, v in (s.split("=", 1) for s in a.set)}
+    config = GraphDistNetConfig.from_dict(PRESETS[a.preset]().to_dict() | overrides)
+    card = train(
+        a.env,
+        config,
+        a.name or a.preset,
+        a.n_train,
+        a.batch,
+        a.lr,
+        a.epochs,
+        a.patience,
+        a.time_budget,
+        a.seed,
+        a.device,
+        out=a.out,
+    )
+    print(json.dumps({"env": a.env, "name": card["name"], **card["test"]}, indent=2))
+
+
+if __name__ == "__main__":
+    main()
