@@ -341,6 +341,29 @@ class TableSettings:
         return cls(n=200, n_grad=100, diffco_train=(400, 600), al_scenes=1, al_queries=100)
 
 
+class BatchedGraphDistNet:
+    """GraphDistNet with :meth:`predict_dataset`: one batched pass over samples with their own
+    obstacle graphs (graph construction included), via :mod:`gdnplan.train`'s tensors."""
+
+    name = "GraphDistNet"
+    is_distance = True
+
+    def __init__(self, model):
+        self.model = model
+
+    def distance(self, scene, q: np.ndarray) -> np.ndarray:
+        return self.model.distance(scene, q)
+
+    def distance_and_grad(self, scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.model.distance_and_grad(scene, q)
+
+    def predict_dataset(self, ds: Dataset, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        from .train import predict as predict_net
+        from .train import tensors
+
+        return predict_net(self.model.net, tensors(ds, self.model.net.config), grad=grad)
+
+
 def load_graphdistnet(env: str) -> DistanceModel | None:
     """GraphDistNet from ``weights/<env>.safetensors`` when it exists, else None."""
     path = WEIGHTS_DIR / f"{env}.safetensors"
@@ -348,9 +371,7 @@ def load_graphdistnet(env: str) -> DistanceModel | None:
         return None
     from .train import load_weights
 
-    model = load_weights(path)
-    model.name = "GraphDistNet"
-    return model
+    return BatchedGraphDistNet(load_weights(path))
 
 
 def load_clearancenet(env: str) -> DistanceModel | None:
