@@ -448,6 +448,11 @@ class FetchLayout:
         centre = self.stick_start - GRASP_GAP - BODY_LENGTH + TCP
         return np.array([centre, self.shelf + self.stick_width / 2, 0.0])
 
+    def pregrasp_target(self) -> np.ndarray:
+        """tcp pose of the grasp drawn back until the fingertips are 0.03 m before the box."""
+        fingertips = self.front - 0.03
+        return np.array([fingertips - FINGER_LENGTH / 2, *self.grasp_target()[1:]])
+
     def lift_target(self) -> np.ndarray:
         """tcp pose of the grasp raised by LIFT: the held stick off its shelf."""
         return self.grasp_target() + np.array([0.0, LIFT, 0.0])
@@ -537,10 +542,11 @@ def fetch_configurations(layout: FetchLayout) -> dict[str, np.ndarray] | None:
     """Free configurations of a layout (coal clearance ≥ MIN_CLEARANCE), or None.
 
     ``q_grasp``: gripper open and horizontal through the entrance, fingers around the stick's
-    near end (the stick an obstacle). ``q_lift``: the same grasp raised by LIFT, stick held.
+    near end (the stick an obstacle). ``q_pregrasp``: the same gripper attitude drawn back out of
+    the entrance (a waypoint for planners). ``q_lift``: the same grasp raised by LIFT, stick held.
     ``q_home`` (gripper open, above and in front of the box) and ``q_out`` (stick held, entirely
     outside the box) are the free IK solutions nearest to q_grasp. The fetch sequence is
-    home → grasp (open), close, lift → out (holding).
+    home → pregrasp → grasp (open), close, lift → out (holding).
     """
     scenes = _fetch_scenes(layout)
     robot = scenes["open"].robot
@@ -549,6 +555,7 @@ def fetch_configurations(layout: FetchLayout) -> dict[str, np.ndarray] | None:
         return None
     configs = {"q_grasp": q_grasp}
     for key, target, state in (
+        ("q_pregrasp", layout.pregrasp_target(), "open"),
         ("q_lift", layout.lift_target(), "holding"),
         ("q_home", layout.home_target(), "open"),
         ("q_out", layout.out_target(), "holding"),
@@ -571,7 +578,7 @@ def fetch_scene(seed: int = 0, gripper: str = "open", max_tries: int = 100) -> S
 
     ``info``: ``layout`` (FetchLayout), ``storage`` and ``stick`` and ``table`` polygons,
     ``entrance`` (u, v_low, v_high), ``stick_center``, ``stick_length``, ``stick_width``,
-    ``grasp_tcp`` (u, v, φ), ``q_grasp``, ``q_lift``, ``q_home``, ``q_out`` (3,) and
+    ``grasp_tcp`` (u, v, φ), ``q_grasp``, ``q_pregrasp``, ``q_lift``, ``q_home``, ``q_out`` (3,) and
     ``gripper``.
     """
     if gripper not in GRIPPER_STATES:

@@ -13,7 +13,7 @@ from gdnplan.geometry import is_convex
 from gdnplan.scene import scene_from_config
 
 PROBLEMS = Path(__file__).resolve().parent.parent / "problems"
-CONFIGS = ("q_grasp", "q_lift", "q_home", "q_out")
+CONFIGS = ("q_grasp", "q_lift", "q_home", "q_out", "q_pregrasp")
 
 
 def polygon(robot, q, name):
@@ -44,6 +44,9 @@ def check_fetch(seed: int) -> None:
     d_open, d_held = gp.signed_distance(scene, q), gp.signed_distance(held, q)
     assert d_open[0] >= U.MIN_CLEARANCE and d_open[2] >= U.MIN_CLEARANCE  # grasp, home
     assert d_held[1] >= U.MIN_CLEARANCE and d_held[3] >= U.MIN_CLEARANCE  # lift, out
+    assert d_open[4] >= U.MIN_CLEARANCE  # pregrasp: outside the box, aligned with the entrance
+    pre = U.tcp_pose(scene.robot, info["q_pregrasp"])
+    assert pre[0] + U.FINGER_LENGTH / 2 < front and pre[1:] == pytest.approx(info["grasp_tcp"][1:])
     # grasp: gripper horizontal into the box, fingers above and below the stick's near end
     np.testing.assert_allclose(
         U.tcp_pose(scene.robot, info["q_grasp"]), info["grasp_tcp"], atol=1e-9
