@@ -48,7 +48,7 @@ class CoalModel:
 def load_model(path: Path | str) -> DistanceModel:
     """Load a trained model: ``path`` (safetensors weights) and its JSON card beside it.
 
-    The card's ``"model"`` field selects the class (``"graphdistnet"``).
+    The card's ``"model"`` field selects the class (``"graphdistnet"``, ``"clearancenet"``).
     """
     path = Path(path)
     card = path.with_suffix(".json")
@@ -59,6 +59,10 @@ def load_model(path: Path | str) -> DistanceModel:
         from .graphdistnet import load_graphdistnet
 
         return load_graphdistnet(path)
+    if kind == "clearancenet":
+        from .clearancenet import load as load_clearancenet
+
+        return load_clearancenet(path)
     raise UnknownNameError(f"model: unknown model type {kind!r} in {card.name}")
 
 
