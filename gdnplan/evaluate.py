@@ -369,9 +369,9 @@ def load_graphdistnet(env: str) -> DistanceModel | None:
     path = WEIGHTS_DIR / f"{env}.safetensors"
     if not path.exists():
         return None
-    from .train import load_weights
+    from .models import load_model
 
-    return BatchedGraphDistNet(load_weights(path))
+    return BatchedGraphDistNet(load_model(path))
 
 
 def load_clearancenet(env: str) -> DistanceModel | None:
