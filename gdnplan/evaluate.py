@@ -328,6 +328,7 @@ class TableSettings:
         diffco_train: DiffCo training configurations (2-DoF, 7-DoF).
         al_scenes: test scenes DiffCo adapts to (active learning), per random environment.
         al_queries: configurations evaluated in each adapted scene.
+        al_explore: uniform samples per active-learning update (besides 2 per support point).
     """
 
     n: int = 5000
@@ -335,10 +336,13 @@ class TableSettings:
     diffco_train: tuple[int, int] = (3000, 5000)
     al_scenes: int = 10
     al_queries: int = 200
+    al_explore: int = 2000
 
     @classmethod
     def fast(cls) -> TableSettings:
-        return cls(n=200, n_grad=100, diffco_train=(400, 600), al_scenes=1, al_queries=100)
+        return cls(
+            n=200, n_grad=100, diffco_train=(400, 600), al_scenes=1, al_queries=100, al_explore=300
+        )
 
 
 class BatchedGraphDistNet:
@@ -408,7 +412,9 @@ def diffco_rows(env: str, ds: Dataset, s: TableSettings) -> list[Result]:
     scores, grads, d_true, g_true, qs, adapt_time = [], [], [], [], [], 0.0
     for i in range(min(s.al_scenes, len(ds))):
         scene = ds.scene(i)
-        adapted, t = timed(lambda scene=scene, i=i: base.adapt(scene, seed=i))
+        adapted, t = timed(
+            lambda scene=scene, i=i: base.adapt(scene, n_explore=s.al_explore, seed=i)
+        )
         adapt_time += t
         q = scene.robot.sample(s.al_queries, seed=[7, i])
         f, gf = signed_distance_and_grad(scene, q)
