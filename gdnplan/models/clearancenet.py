@@ -291,3 +291,34 @@ def train(
         "parameters": sum(p.numel() for p in net.parameters()),
     }
     return ClearanceNetModel(net, card)
+
+
+def train_and_save(env: str, time_budget: float = 120.0, out: Path | str | None = None) -> dict:
+    """Train on ``data/<env>/train``, score on the test split, write ``weights/clearancenet_<env>``.
+
+    Returns the card (training log summary and test metrics: n, MAE (m), AUC, ACD).
+    """
+    from ..data import load, split_dir
+    from ..evaluate import WEIGHTS_DIR, evaluate_model
+
+    torch.set_num_threads(1)
+    model = train(env, load(split_dir(env, "train")), time_budget=time_budget)
+    r = evaluate_model(model, env, n=5000)
+    model.card["test"] = {"n": r.n, "mae_m": r.mae, "auc": r.auc, "acd": r.acd, "n_grad": r.n_grad}
+    model.card["command"] = (
+        f"python -m gdnplan.models.clearancenet {env} --time-budget {time_budget:g}"
+    )
+    model.save(out or WEIGHTS_DIR / f"clearancenet_{env}.safetensors")
+    return model.card
+
+
+if __name__ == "__main__":
+    import argparse
+
+    parser = argparse.ArgumentParser(description="Train ClearanceNet baselines (Table I).")
+    parser.add_argument("envs", nargs="+", choices=["a", "b", "c", "d", "e"])
+    parser.add_argument("--time-budget", type=float, default=120.0, help="seconds per env")
+    args = parser.parse_args()
+    for env in args.envs:
+        card = train_and_save(env, args.time_budget)
+        print(env, json.dumps({"training": card["training"], "test": card["test"]}))
