@@ -466,6 +466,32 @@ def table1_env(env: str, s: TableSettings) -> tuple[list[Result], float | None]:
     return rows, p
 
 
+NOTES = """
+Notes (how each number is made; `paper` columns are the paper's Table I):
+
+- Samples: the first n of `data/<env>/test` (seed 1, one obstacle set per sample in b, d, e);
+  the same samples for every method. MAE, AUC and time over n; ACD over the first n_grad
+  ([n] in the ACD column), coal's exact gradient as reference, rows with a zero coal gradient
+  left out. AUC: positives are coal's f ≤ 0, the score is −d̂.
+- Time: fastest of 3 wall times of the distance batch on this shared 2-core CPU (coal: one run,
+  one call per obstacle set including building its coal shapes; learned models: one batched
+  pass, GraphDistNet including graph construction). The paper timed a GPU for the networks.
+- MAE [/reach]: metres, and as a fraction of the arm's reach (1.2 m planar2, 2.1 m planar7).
+  p: Welch's t-test between GraphDistNet's and ClearanceNet's absolute errors.
+- DiffCo: FK-kernel perceptron (Fastron updates) trained on 3000 (2-DoF) or 5000 (7-DoF)
+  coal-labelled configurations of a (for a, b), c (for c, d) or one random e scene (for e).
+  AUC and time use the perceptron score; ACD uses the fitted surrogate (kernel ridge regression
+  of coal's f over the labelled configurations), DiffCo's smooth score for optimisation.
+  w/ AL: active learning on the scenes of the first 10 test samples (relabel support points,
+  2 Gaussian perturbations each, 2000 uniform samples, continue the perceptron); AUC and ACD
+  pool 200 uniform configurations per adapted scene; time = mean adaptation time per scene
+  × n (extrapolated, as the paper adapts to every test scene).
+- ClearanceNet: MLP 3×256 ReLU on [q/π, obstacle poses (centre, cos 4θ, sin 4θ) or padded
+  α-shape vertices], dropout 0.5 for d and e, Adam on data/<env>/train (weights card: data,
+  epochs, seconds); a 120 s training budget per environment on this CPU.
+"""
+
+
 def _num(v: float | None, fmt: str) -> str:
     return "–" if v is None or (isinstance(v, float) and np.isnan(v)) else format(v, fmt)
 
@@ -494,7 +520,7 @@ def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> st
                 f"| {_num(r.acd, '.4f')}{f' [{r.n_grad}]' if r.acd is not None else ''} "
                 f"| {_num(pc, '.4f')} |"
             )
-    return "\n".join(lines)
+    return "\n".join(lines) + "\n" + NOTES
 
 
 def table1(envs: tuple[str, ...] = ENVS, fast: bool = False, log=print):
