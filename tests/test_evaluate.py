@@ -79,3 +79,22 @@ def test_reproduce_table1_fast_writes_markdown(tmp_path):
     assert res.exit_code == 0, res.output
     text = out.read_text()
     assert "| a | coal |" in text and "| a | DiffCo |" in text and "machine:" in text
+
+
+def test_fig5_panels_and_detour_path_is_free():
+    scene = gp.make_scene("a")
+    path = ev.detour_path(scene, np.array([1.3, 1.5]), np.array([1.3, -2.6]))
+    assert gp.signed_distance(scene, path).min() > 0
+    fig = ev.fig5("a", grid=11, diffco_train=200)
+    has_gdn = (ev.WEIGHTS_DIR / "a.safetensors").exists()
+    assert len(fig.axes) == 3 + has_gdn
+
+
+def test_roc_and_scatter_figures(tmp_path):
+    ds = make_shard("a", 1, 0, 50)
+    rows = [
+        ev.Result("coal", "a", 50, 0.1, None, None, float("nan"), None, 0, None, ds.d),
+        ev.evaluate_predictions("noisy", ds, ds.d + 0.01, None, 0.1, True, 1.2),
+    ]
+    paths = ev.table1_figures({"a": (rows, None)}, tmp_path)
+    assert all(p.stat().st_size > 1000 for p in paths)
