@@ -477,7 +477,8 @@ Notes (how each number is made; `paper` columns are the paper's Table I):
   one call per obstacle set including building its coal shapes; learned models: one batched
   pass, GraphDistNet including graph construction). The paper timed a GPU for the networks.
 - MAE [/reach]: metres, and as a fraction of the arm's reach (1.2 m planar2, 2.1 m planar7).
-  p: Welch's t-test between GraphDistNet's and ClearanceNet's absolute errors.
+  p (GraphDistNet row): two-sided Welch's t-test between GraphDistNet's and ClearanceNet's
+  absolute errors, with the method whose MAE is lower.
 - DiffCo: FK-kernel perceptron (Fastron updates) trained on 3000 (2-DoF) or 5000 (7-DoF)
   coal-labelled configurations of a (for a, b), c (for c, d) or one random e scene (for e).
   AUC and time use the perceptron score; ACD uses the fitted surrogate (kernel ridge regression
@@ -496,6 +497,15 @@ def _num(v: float | None, fmt: str) -> str:
     return "–" if v is None or (isinstance(v, float) and np.isnan(v)) else format(v, fmt)
 
 
+def _p_text(p: float | None, rows: list[Result]) -> str:
+    """Welch's p with the side whose MAE is lower (the test itself is two-sided)."""
+    if p is None:
+        return "–"
+    mae = {r.method: r.mae for r in rows}
+    lower = "GDN" if mae["GraphDistNet"] < mae["ClearanceNet"] else "CN"
+    return f"{'< 1e-300' if p == 0 else format(p, '.1e')} ({lower} lower)"
+
+
 def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> str:
     """Markdown of Table I: ours beside the paper's numbers (paper in the ``paper`` columns)."""
     head = (
@@ -506,7 +516,8 @@ def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> st
     for env, (rows, p) in results.items():
         for r in rows:
             pt, pm, pa, pc = PAPER[env].get(r.method, (None,) * 4)
-            learned = r.method in ("ClearanceNet", "GraphDistNet")
+            learned = r.method == "GraphDistNet"
+            p_text = _p_text(p, rows) if learned else ""
             mae = (
                 "N/A"
                 if r.method.startswith("DiffCo")
@@ -514,7 +525,7 @@ def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> st
             )
             lines.append(
                 f"| {env} | {r.method} | {r.seconds:.4g} | {_num(pt, '.5g')} | {mae} "
-                f"| {_num(pm, '.4f')} | {_num(p, '.1e') if learned else ''} "
+                f"| {_num(pm, '.4f')} | {p_text} "
                 f"| {_num(PAPER_P[env], '.0e') if learned else ''} "
                 f"| {_num(r.auc, '.4f')} | {_num(pa, '.4f')} "
                 f"| {_num(r.acd, '.4f')}{f' [{r.n_grad}]' if r.acd is not None else ''} "
