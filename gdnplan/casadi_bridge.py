@@ -14,6 +14,7 @@ costs one model pass. Build the NLP with MX symbols (SX would call the callback 
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -28,15 +29,27 @@ from .scene import Scene
 BatchFn = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 
+def supports_per_link(model: DistanceModel) -> bool:
+    """True when the model's ``distance_and_grad`` takes ``per_link`` (coal always does)."""
+    if isinstance(model, CoalModel):
+        return True
+    try:
+        return "per_link" in inspect.signature(model.distance_and_grad).parameters
+    except (TypeError, ValueError):
+        return False
+
+
 def distance_rows(
     model: DistanceModel, scene: Scene, per_link: bool = False, cap: float = np.inf
 ) -> tuple[BatchFn, int]:
     """The batched function q (B, dof) -> (d (B, R), ∂d/∂q (B, R, dof)) and its row count R.
 
-    With ``per_link`` there is one row per link polygon; for coal, pairs farther than ``cap``
-    (m) are skipped and report ``cap`` with a zero gradient (an inactive constraint).
-    Other models must accept ``per_link=True`` in ``distance_and_grad``.
+    With ``per_link`` there is one row per link polygon; distances above ``cap`` (m) report
+    ``cap`` with a zero gradient (an inactive constraint; coal skips those pairs entirely).
+    Raises InputError when the model has no per-link distances.
     """
+    if per_link and not supports_per_link(model):
+        raise InputError(f"per_link: model {model.name!r} has no per-link distances")
     if not per_link:
 
         def overall(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -53,10 +66,7 @@ def distance_rows(
         return coal_links, scene.robot.n_links
 
     def links(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        try:
-            d, g = model.distance_and_grad(scene, q, per_link=True)
-        except TypeError as e:
-            raise InputError(f"per_link: model {model.name!r} has no per-link distances") from e
+        d, g = model.distance_and_grad(scene, q, per_link=True)
         return np.minimum(np.asarray(d, float), cap), np.asarray(g, float) * (d < cap)[..., None]
 
     return links, scene.robot.n_links
@@ -178,4 +188,4 @@ class _JacobianCallback(casadi.Callback):
         return [casadi.DM(self.sparsity, nz)]
 
 
-__all__ = ["DistanceCallback", "block_sparsity", "distance_rows"]
+__all__ = ["DistanceCallback", "block_sparsity", "distance_rows", "supports_per_link"]

@@ -71,14 +71,15 @@ class Certificate:
         min_distance: smallest exact coal distance over all checked configurations (m).
         lower_bound: certified lower bound on the distance along the whole path (m).
         n_checks: coal evaluations made.
-        worst_segment: index of the waypoint segment holding the smallest checked distance.
+        bad_segments: indices of the waypoint segments holding a configuration within the
+            margin (or left uncertified by the check budget).
     """
 
     ok: bool
     min_distance: float
     lower_bound: float
     n_checks: int
-    worst_segment: int
+    bad_segments: tuple[int, ...]
 
 
 def certify_path(
@@ -110,15 +111,14 @@ def certify_path(
     d_nodes = signed_distance(scene, nodes)
     da, db = d_nodes[:-1], d_nodes[1:]
     n_checks = len(nodes)
-    checked_d, checked_seg = [d_nodes], [np.append(seg, seg[-1])]
-    lower, ok = np.inf, True
+    checked_d = [d_nodes]
+    lower, bad_segments = np.inf, set()
     while len(qa):
         delta = motion_bound(robot, qa, qb)
         bad = (da <= margin) | (db <= margin)
-        if bad.any():
-            ok = False
-            if stop_early:
-                break
+        bad_segments.update(seg[bad].tolist())
+        if bad_segments and stop_early:
+            break
         done = bad | (da + db - delta >= 2 * margin) | (delta <= tol)
         if done.any():
             bound = np.minimum((da + db - delta) / 2, np.minimum(da, db))
@@ -128,20 +128,19 @@ def certify_path(
             )
         keep = ~done
         if n_checks + keep.sum() > max_checks:
-            ok = False
+            bad_segments.update(seg[keep].tolist())
             break
         qa, qb, da, db, seg = qa[keep], qb[keep], da[keep], db[keep], seg[keep]
         mid = (qa + qb) / 2
         dm = signed_distance(scene, mid) if len(mid) else np.zeros(0)
         n_checks += len(mid)
         checked_d.append(dm)
-        checked_seg.append(seg)
         qa, qb = np.concatenate([qa, mid]), np.concatenate([mid, qb])
         da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
         seg = np.concatenate([seg, seg])
-    all_d, all_seg = np.concatenate(checked_d), np.concatenate(checked_seg)
-    worst = int(np.argmin(all_d))
-    return Certificate(ok, float(all_d[worst]), lower, n_checks, int(all_seg[worst]))
+    min_d = float(np.min(np.concatenate(checked_d)))
+    ok = not bad_segments
+    return Certificate(ok, min_d, lower, n_checks, tuple(sorted(bad_segments)))
 
 
 def verify_path(scene: Scene, q_path: np.ndarray, margin: float = 0.0) -> tuple[bool, float]:

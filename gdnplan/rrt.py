@@ -67,7 +67,7 @@ def rrt_connect(
     start: np.ndarray,
     goal: np.ndarray,
     clearance: float = 0.0,
-    step: float = 0.5,
+    step: float = 2.0,
     max_iterations: int = 5000,
     time_limit: float = 10.0,
     seed: int = 0,

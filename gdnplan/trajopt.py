@@ -4,17 +4,21 @@ Direct transcription over T waypoints Q = (q_0, …, q_{T−1}), q_0 = start, q_
 
     minimise    Σ_t ‖q_{t+1} − q_t‖²                                   (the paper's path cost)
     subject to  lower ≤ q_t ≤ upper,   |q_{t+1} − q_t| ≤ max_step      (joint, step limits)
-                d(p_k) ≥ margin           for the K = T + (T−1)·M check points
-                                          p = q_t + i/(M+1) (q_{t+1} − q_t), i = 0 … M
-                d(p_k) + d(p_{k+1}) ≥ δ(p_k, p_{k+1}) + 2·margin              (CCD, optional)
+                d(p_k) ≥ margin           at the check points p = q_t + i/n_t (q_{t+1} − q_t),
+                                          i = 0 … n_t − 1, of every segment t (n_t = M + 1 first)
 
 with d the overall or per-link distance of any DistanceModel (one batched call through
-:class:`~gdnplan.casadi_bridge.DistanceCallback`) and δ the conservative-advancement motion
-bound of :mod:`gdnplan.ccd` (smoothed |x| ≈ √(x² + ε²) ≥ |x|): the last rows certify that the
-continuous motion between consecutive check points keeps the margin. Ipopt with a
-limited-memory Hessian solves it from a straight-line or RRT-Connect seed, restarting from new
-seeds on failure. A plan succeeds only when :func:`gdnplan.ccd.verify_path` certifies the
-returned path with coal and the goal is reached — never on the solver's word alone.
+:class:`~gdnplan.casadi_bridge.DistanceCallback`). Continuous collision (the CCD certificate):
+after each solve, :func:`gdnplan.ccd.certify_path` checks the continuous motion with coal by
+conservative advancement; every waypoint segment it cannot certify gets twice as many check
+points (n_t ← 2 n_t) and Ipopt re-solves from the current path, for ``refine_rounds`` rounds.
+(The certificate as NLP rows, d(p_k) + d(p_{k+1}) ≥ δ(p_k, p_{k+1}) + 2·margin, was tried and
+dropped: at 3 check points per segment δ reaches ~1 m on seed paths, the rows are infeasible
+and Ipopt runs to its iteration cap.) Ipopt uses a limited-memory Hessian and starts from the
+straight line when it is certified free (then it is already optimal and returned as is) or
+from RRT-Connect seeds, restarting from a new seed on failure. A plan succeeds only when
+:func:`gdnplan.ccd.verify_path` certifies the returned path with coal and the goal is reached —
+never on the solver's word alone.
 """
 
 from __future__ import annotations
@@ -22,15 +26,15 @@ from __future__ import annotations
 import math
 import time
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import casadi
 import numpy as np
 import pinocchio as pin
 
-from .casadi_bridge import DistanceCallback
-from .ccd import certify_path, lever_arms, verify_path
+from .casadi_bridge import DistanceCallback, supports_per_link
+from .ccd import certify_path, verify_path
 from .distance import signed_distance
 from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
 from .models import CoalModel, DistanceModel
@@ -40,6 +44,7 @@ from .scene import Scene, scene_from_config
 
 WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
 TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options"}
+SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
 OPTION_KEYS = {"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"}
 
 
@@ -261,9 +266,11 @@ class TrajoptOptions:
     Attributes:
         initial: "auto" (straight line when certified free, else RRT-Connect seeds),
             "straight" (always the straight line) or "rrt" (always RRT-Connect seeds).
-        ccd: add the conservative-advancement rows between consecutive check points.
-        per_link: one distance row per link polygon (capped at ``link_cap``) instead of one.
-        interpolated: M check points strictly between consecutive waypoints.
+        ccd: refine the check points of segments the continuous certificate rejects.
+        refine_rounds: re-solves with refined check points (with ``ccd``).
+        per_link: one distance row per link polygon (capped at ``link_cap``) instead of one;
+            None: when the model provides per-link distances (coal does).
+        interpolated: M check points strictly between consecutive waypoints (before refining).
         starts: Ipopt attempts (new seed path each) before giving up.
         max_iter: Ipopt iteration cap per attempt.
         tol: Ipopt tolerance.
@@ -276,11 +283,12 @@ class TrajoptOptions:
 
     initial: str = "auto"
     ccd: bool = True
-    per_link: bool = True
+    refine_rounds: int = 3
+    per_link: bool | None = None
     interpolated: int = 3
     starts: int = 3
-    max_iter: int = 300
-    tol: float = 1e-4
+    max_iter: int = 150
+    tol: float = 1e-3
     rrt_clearance: float = 0.02
     rrt_time: float = 5.0
     link_cap: float = 0.3
@@ -429,10 +437,7 @@ def straight_line(start: np.ndarray, goal: np.ndarray, n: int) -> np.ndarray:
 def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
     """Yield (label, initial guess (T, dof) or None when RRT-Connect failed) per attempt."""
     line = straight_line(problem.start, goal, problem.waypoints)
-    use_line = opts.initial == "straight" or (
-        opts.initial == "auto"
-        and certify_path(problem.scene, line, problem.margin, stop_early=True).ok
-    )
+    use_line = opts.initial == "straight"
     rng = np.random.default_rng(seed)
     for attempt in range(opts.starts):
         if use_line:
@@ -454,60 +459,81 @@ def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
         yield f"RRT-Connect seed {seed + attempt}", guess
 
 
+def _line_free(problem: Problem, line: np.ndarray) -> bool:
+    """The straight line (T, dof) respects the step bound and is certified at the margin."""
+    if np.max(np.abs(np.diff(line, axis=0))) > problem.max_step:
+        return False
+    return certify_path(problem.scene, line, problem.margin, stop_early=True).ok
+
+
 def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, seed: int) -> _Run:
-    nlp = _Transcription(problem, model, goal, opts)
-    run = _Run(q=straight_line(problem.start, goal, problem.waypoints))
+    line = straight_line(problem.start, goal, problem.waypoints)
+    if opts.initial == "auto" and _line_free(problem, line):
+        status = "straight line certified free (optimal path cost, no solve needed)"
+        return _Run(q=line, status=status, reason=status)
+    run = _Run(q=line)
     for label, guess in _seeds(problem, goal, opts, seed):
         run.attempts += 1
         if guess is None:
             run.reason = f"{run.reason}; {label}: RRT-Connect found no path".lstrip("; ")
             continue
-        q, stats = nlp.solve(guess)
-        run.iterations += stats.get("iter_count", 0)
-        run.status = stats.get("return_status", "exception")
-        run.q = q
-        run.verified = verify_path(problem.scene, q, margin=0.0)
-        if run.verified[0]:
+        q, stats, ok = _solve_refined(problem, model, goal, opts, guess, run)
+        run.q, run.status = q, stats.get("return_status", "exception")
+        if ok:
             run.reason = f"{label}: {run.status}"
             break
         run.reason = f"{run.reason}; {label}: {run.status}, path not certified".lstrip("; ")
-    run.model_calls = nlp.callback.model_calls
     return run
+
+
+def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: _Run):
+    """Solve, certify, refine uncertified segments, re-solve: (q, last stats, certified)."""
+    splits = np.full(problem.waypoints - 1, opts.interpolated + 1)
+    per_link = supports_per_link(model) if opts.per_link is None else opts.per_link
+    q = guess
+    for _ in range(1 + (opts.refine_rounds if opts.ccd else 0)):
+        nlp = _Transcription(problem, model, goal, replace(opts, per_link=per_link), splits)
+        q, stats = nlp.solve(q)
+        run.iterations += stats.get("iter_count", 0)
+        run.model_calls += nlp.callback.model_calls
+        status = stats["return_status"]
+        if status in SOLVER_ERRORS or status.startswith("exception"):
+            run.verified = None  # q is not a solver iterate: never accept it
+            return q, stats, False
+        cert = certify_path(problem.scene, q, margin=0.0)
+        run.verified = (cert.ok, cert.min_distance)
+        if cert.ok:
+            return q, stats, True
+        splits[list(cert.bad_segments)] *= 2
+    return q, stats, False
 
 
 class _Transcription:
     """The NLP of the module docstring, built once and solved from several initial guesses."""
 
-    def __init__(self, problem: Problem, model: DistanceModel, goal: np.ndarray, opts):
+    def __init__(self, problem: Problem, model: DistanceModel, goal, opts, splits: np.ndarray):
         robot = problem.scene.robot
-        T, n, M = problem.waypoints, robot.dof, opts.interpolated
+        T, n = problem.waypoints, robot.dof
         self.problem, self.goal, self.T = problem, goal, T
         x = casadi.MX.sym("x", (T - 2) * n)
         Q = casadi.vertcat(
             casadi.DM(problem.start).T, casadi.reshape(x, n, T - 2).T, casadi.DM(goal).T
         )  # (T, n)
-        W = _interpolation_matrix(T, M)  # (K, T)
-        P = casadi.mtimes(casadi.sparsify(casadi.DM(W)), Q)  # (K, n) check points along the path
+        W = casadi.sparsify(casadi.DM(_interpolation_matrix(splits)))  # (K, T)
+        P = casadi.mtimes(W, Q)  # (K, n) check points along the path
         K = W.shape[0]
         self.callback = DistanceCallback(
             "distance", model, problem.scene, K, opts.per_link, opts.link_cap
         )
         rows = self.callback.rows
-        d = casadi.reshape(self.callback(casadi.reshape(P.T, K * n, 1)), rows, K).T  # (K, R)
-        g = [casadi.reshape(d - problem.margin, K * rows, 1)]
-        lbg = [np.zeros(K * rows)]
-        if opts.ccd:
-            arms = lever_arms(robot) if opts.per_link else lever_arms(robot).max(0, keepdims=True)
-            dq = P[1:, :] - P[:-1, :]
-            delta = casadi.mtimes(casadi.sqrt(dq**2 + 1e-8), casadi.sparsify(casadi.DM(arms.T)))  # (K-1, R)
-            cert = d[:-1, :] + d[1:, :] - delta - 2 * problem.margin
-            g.append(casadi.reshape(cert, (K - 1) * rows, 1))
-            lbg.append(np.zeros((K - 1) * rows))
-        steps = Q[1:, :] - Q[:-1, :]
-        g.append(casadi.reshape(steps, (T - 1) * n, 1))
-        lbg.append(np.full((T - 1) * n, -problem.max_step))
-        ubg = [np.full(len(b), np.inf) for b in lbg[:-1]] + [np.full((T - 1) * n, problem.max_step)]
-        self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
+        d = self.callback(casadi.reshape(P.T, K * n, 1))  # (K·R,)
+        steps = Q[1:, :] - Q[:-1, :]  # (T−1, n)
+        g = casadi.vertcat(d, casadi.reshape(steps, (T - 1) * n, 1))
+        n_steps = (T - 1) * n
+        self.lbg = np.concatenate(
+            [np.full(K * rows, problem.margin), np.full(n_steps, -problem.max_step)]
+        )
+        self.ubg = np.concatenate([np.full(K * rows, np.inf), np.full(n_steps, problem.max_step)])
         self.lbx = np.tile(problem.lower, T - 2)
         self.ubx = np.tile(problem.upper, T - 2)
         f = casadi.sumsqr(steps)
@@ -516,14 +542,16 @@ class _Transcription:
             "print_level": 0,
             "max_iter": opts.max_iter,
             "tol": opts.tol,
-            "acceptable_tol": 1e-3,
-            "acceptable_iter": 5,
+            "acceptable_tol": 1e3,  # stop on objective stagnation + feasibility
+            "acceptable_iter": 3,
+            "acceptable_obj_change_tol": 1e-4,
+            "acceptable_constr_viol_tol": 1e-5,
             "mu_strategy": "adaptive",
         }
         self.solver = casadi.nlpsol(
             "trajopt",
             "ipopt",
-            {"x": x, "f": f, "g": casadi.vertcat(*g)},
+            {"x": x, "f": f, "g": g},
             {"ipopt": ipopt, "print_time": False, "error_on_fail": False},
         )
 
@@ -533,20 +561,21 @@ class _Transcription:
         try:
             sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         except RuntimeError as e:
-            return guess, {"return_status": f"exception: {str(e).splitlines()[-1]}"}
+            return guess, {"return_status": f"exception: {str(e).splitlines()[-1]}"[:200]}
         inner = np.asarray(sol["x"]).reshape(self.T - 2, -1)
         stats = self.solver.stats()
         return np.vstack([self.problem.start, inner, self.goal]), stats
 
 
-def _interpolation_matrix(T: int, M: int) -> np.ndarray:
-    """(T + (T−1)·M, T) weights: row k of W·Q is the k-th check point along the path."""
+def _interpolation_matrix(splits: np.ndarray) -> np.ndarray:
+    """(Σ n_t + 1, T) weights: row k of W·Q is the k-th check point along the path, with
+    segment t split into n_t = splits[t] pieces."""
+    T = len(splits) + 1
     rows = []
-    for t in range(T - 1):
-        for i in range(M + 1):
+    for t, n_t in enumerate(splits):
+        for i in range(n_t):
             w = np.zeros(T)
-            s = i / (M + 1)
-            w[t], w[t + 1] = 1 - s, s
+            w[t], w[t + 1] = 1 - i / n_t, i / n_t
             rows.append(w)
     last = np.zeros(T)
     last[-1] = 1.0
@@ -574,8 +603,8 @@ def collision_cost(
 def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -> _Run:
     """Adam on the interior waypoints of Σ_k C(d(p_k)) + Σ_t ‖q_{t+1} − q_t‖², from the
     straight line, until every check point has d ≥ margin + adam_stop or the iteration cap."""
-    T, M = problem.waypoints, opts.interpolated
-    W = _interpolation_matrix(T, M)
+    T = problem.waypoints
+    W = _interpolation_matrix(np.full(T - 1, opts.interpolated + 1))
     q = straight_line(problem.start, goal, T)
     m, v = np.zeros_like(q), np.zeros_like(q)
     b1, b2 = 0.9, 0.999

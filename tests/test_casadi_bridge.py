@@ -1,0 +1,96 @@
+from pathlib import Path
+
+import casadi
+import numpy as np
+import pytest
+
+import gdnplan as gp
+from gdnplan.casadi_bridge import DistanceCallback
+
+
+class SmoothModel:
+    """Stand-in differentiable DistanceModel: d(q) = 0.5 + Σ_j a_j sin(q_j + b_j)."""
+
+    name = "smooth"
+
+    def __init__(self, dof: int):
+        rng = np.random.default_rng(0)
+        self.a, self.b = rng.uniform(0.1, 0.3, dof), rng.uniform(0, 3, dof)
+
+    def distance(self, scene, q):
+        return 0.5 + np.sin(np.atleast_2d(q) + self.b) @ self.a
+
+    def distance_and_grad(self, scene, q):
+        q = np.atleast_2d(q)
+        return self.distance(scene, q), np.cos(q + self.b) * self.a
+
+
+def _functions(cb, size):
+    x = casadi.MX.sym("x", size)
+    y = cb(x)
+    return casadi.Function("f", [x], [y]), casadi.Function("J", [x], [casadi.jacobian(y, x)])
+
+
+def _finite_difference(f, x, eps=1e-6):
+    cols = []
+    for i in range(len(x)):
+        dx = np.zeros_like(x)
+        dx[i] = eps
+        cols.append((np.array(f(x + dx)) - np.array(f(x - dx))).ravel() / (2 * eps))
+    return np.stack(cols, 1)
+
+
+@pytest.mark.parametrize(
+    ("model", "per_link"), [("smooth", False), ("coal", False), ("coal", True)]
+)
+def test_callback_jacobian_equals_finite_differences(model, per_link):
+    scene = gp.make_scene("d", seed=3)
+    dof, k = scene.robot.dof, 4
+    m = SmoothModel(dof) if model == "smooth" else gp.CoalModel()
+    cb = DistanceCallback("d", m, scene, k, per_link=per_link)
+    f, jac = _functions(cb, k * dof)
+    x = scene.robot.sample(k, seed=1).ravel()
+    J = np.array(jac(x))
+    rows = scene.robot.n_links if per_link else 1
+    assert J.shape == (k * rows, k * dof)
+    np.testing.assert_allclose(J, _finite_difference(f, x), atol=1e-6)
+    # block-diagonal: distance rows of waypoint t only depend on waypoint t
+    assert jac.sparsity_out(0).nnz() == k * rows * dof
+
+
+def test_value_and_jacobian_at_one_point_cost_one_model_call():
+    scene = gp.make_scene("a")
+    cb = DistanceCallback("d", gp.CoalModel(), scene, 3)
+    f, jac = _functions(cb, 6)
+    x = scene.robot.sample(3, seed=0).ravel()
+    d = np.array(f(x)).ravel()
+    jac(x)
+    assert cb.model_calls == 1
+    np.testing.assert_allclose(d, gp.signed_distance(scene, x.reshape(3, 2)))
+
+
+def test_shape_mismatch_raises_input_error():
+    scene = gp.make_scene("a")
+    cb = DistanceCallback("d", gp.CoalModel(), scene, 3)
+    with pytest.raises(gp.InputError, match="x: expected 3·2"):
+        cb.evaluate(np.zeros(5))
+
+
+WEIGHTS_A = Path(__file__).resolve().parent.parent / "weights" / "a.safetensors"
+
+
+@pytest.mark.skipif(not WEIGHTS_A.exists(), reason="no GraphDistNet weights for env a")
+def test_graphdistnet_callback_jacobian_equals_finite_differences():
+    scene = gp.make_scene("a")
+    model = gp.load_model(WEIGHTS_A)
+    cb = DistanceCallback("d", model, scene, 3)
+    f, jac = _functions(cb, 6)
+    x = scene.robot.sample(3, seed=4).ravel()
+    fd = _finite_difference(f, x, eps=1e-3)  # float32 network: larger step
+    np.testing.assert_allclose(np.array(jac(x)), fd, atol=2e-3 * max(1.0, np.abs(fd).max()))
+
+
+def test_per_link_on_a_model_without_it_raises():
+    scene = gp.make_scene("a")
+    with pytest.raises(gp.InputError, match="per_link"):
+        DistanceCallback("d", SmoothModel(2), scene, 3, per_link=True)

@@ -1,0 +1,138 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gdnplan as gp
+from gdnplan.ccd import certify_path, lever_arms, motion_bound, verify_path
+from gdnplan.trajopt import Plan, Problem, TrajoptOptions, plan, straight_line, tip_position
+
+START, GOAL = [1.3, -2.9], [1.5, 0.1]  # planar2 around env a's square; the straight line hits it
+
+
+@pytest.fixture(scope="module")
+def square():
+    return gp.make_scene("a")
+
+
+def test_straight_line_of_the_test_problem_collides(square):
+    ok, dmin = verify_path(square, straight_line(np.array(START), np.array(GOAL), 10))
+    assert not ok and dmin < 0
+
+
+def test_ipopt_solves_planar2_around_a_square_with_coal(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    result = plan(p, collision="coal")
+    assert isinstance(result, Plan)
+    assert result.success, result.reason
+    assert result.iterations > 0 and result.model_calls > 0
+    assert result.q.shape == (10, 2)
+    np.testing.assert_allclose(result.q[[0, -1]], [START, GOAL])
+    ok, dmin = verify_path(square, result.q)
+    assert ok and dmin > 0 and result.min_distance == pytest.approx(dmin)
+
+
+def test_certified_check_rejects_a_path_clipping_a_corner(square):
+    # both waypoints are free; the straight motion between them sweeps the arm through the square
+    path = np.array([[0.2, 0.0], [1.2, 0.0]])
+    assert np.all(gp.signed_distance(square, path) > 0.1)
+    ok, dmin = verify_path(square, path)
+    assert not ok and dmin < 0
+
+
+def test_certificate_is_exact_on_a_free_segment_and_bounds_motion(square):
+    robot = square.robot
+    q = robot.sample(50, seed=3)
+    dq = 1e-3 * np.ones((50, robot.dof))
+    moved = np.linalg.norm(robot.node_positions(q + dq) - robot.node_positions(q), axis=-1).max(1)
+    assert np.all(moved <= motion_bound(robot, q, q + dq) + 1e-12)
+    assert lever_arms(robot).shape == (robot.n_links, robot.dof)
+    cert = certify_path(square, np.array([[-1.0, 0.0], [-2.0, 0.5]]))
+    assert cert.ok and cert.lower_bound > 0 and cert.bad_segments == ()
+
+
+def test_goal_as_end_effector_position(square):
+    target = tip_position(square.robot, np.array(GOAL))[0]
+    p = Problem(scene=square, start=START, goal_position=target, waypoints=10)
+    result = plan(p)
+    assert result.success, result.reason
+    assert np.linalg.norm(tip_position(square.robot, result.q[-1])[0] - target) <= 1e-3
+
+
+def test_solver_failure_returns_unsuccessful_plan_with_reason(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    opts = TrajoptOptions(initial="straight", max_iter=1, ccd=False, starts=1)
+    result = plan(p, options=opts)
+    assert not result.success
+    assert "Maximum_Iterations_Exceeded" in result.reason and "not certified" in result.reason
+
+
+def test_adam_returns_a_plan(square):
+    p = Problem(scene=square, start=[-1.0, 0.0], goal=[-2.0, 0.5], waypoints=10)
+    result = plan(p, solver="adam")
+    assert result.success and result.status.startswith("adam")
+
+
+TOML = """
+[robot]
+name = "planar2"
+[scene]
+generator = "a"
+[start]
+q = {start}
+[goal]
+{goal}
+[options]
+waypoints = 10
+margin = 0.02
+"""
+
+
+def _write(tmp_path, text):
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    return path
+
+
+def test_from_toml_roundtrip(tmp_path, square):
+    path = _write(tmp_path, TOML.format(start=START, goal=f"q = {GOAL}"))
+    p = Problem.from_toml(path)
+    assert p.waypoints == 10 and p.margin == 0.02 and p.scene.name == "a"
+    np.testing.assert_allclose(p.goal, GOAL)
+
+
+@pytest.mark.parametrize(
+    ("start", "goal", "extra", "error", "match"),
+    [
+        ("[0.0, 0.0, 0.0]", "q = [1.0, 0.0]", "", gp.ProblemFileError, "start.q"),
+        ("[0.0, nan]", "q = [1.0, 0.0]", "", gp.ProblemFileError, "start.q: contains NaN"),
+        ("[0.0, 0.0]", "q = [1.0, 0.0]", "\nspeed = 3", gp.ProblemFileError, "unknown key"),
+        ("[0.0, 0.0]", "q = [1.0, 0.0]\nposition = [1, 1]", "", gp.ProblemFileError, "exactly one"),
+        ("[0.0, 0.0", "q = [1.0, 0.0]", "", gp.ProblemFileError, "malformed TOML"),
+        ("[0.7, 0.0]", "q = [1.0, 0.0]", "", gp.InfeasibleProblemError, "start.q is in collision"),
+        ("[0.0, 0.0]", "position = [2.0, 0.5]", "", gp.InfeasibleProblemError, "out of reach"),
+        ("[0.0, 0.0]", "q = [4.0, 0.0]", "", gp.InfeasibleProblemError, "joint limits"),
+    ],
+)
+def test_bad_problem_files_raise_named_errors(tmp_path, start, goal, extra, error, match):
+    path = _write(tmp_path, TOML.format(start=start, goal=goal) + extra)
+    with pytest.raises(error, match=match):
+        Problem.from_toml(path)
+
+
+def test_missing_graphdistnet_weights_raise(square, tmp_path):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    with pytest.raises(gp.GdnplanError, match="weights"):
+        plan(p, collision="graphdistnet", weights=tmp_path / "none.safetensors")
+
+
+WEIGHTS_A = Path(__file__).resolve().parent.parent / "weights" / "a.safetensors"
+
+
+@pytest.mark.skipif(not WEIGHTS_A.exists(), reason="no GraphDistNet weights for env a")
+def test_ipopt_solves_planar2_around_a_square_with_graphdistnet(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=8)
+    result = plan(p, collision="graphdistnet", options=TrajoptOptions(interpolated=1))
+    assert result.success, result.reason
+    assert result.iterations > 0
+    assert verify_path(square, result.q)[0]
