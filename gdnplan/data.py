@@ -168,7 +168,7 @@ def generate(env: str, n: int, seed: int, out_dir: Path | str, workers: int | No
 def load(path: Path | str, n: int | None = None) -> Dataset:
     """Load a split (a directory of shards, or one ``.npz``), at most its first n samples."""
     path = Path(path)
-    files = sorted(path.glob("shard_*.npz")) if path.is_dir() else [path]
+    files = sorted(path.glob("shard_*.npz")) if path.is_dir() else [path] * path.exists()
     files = [f for f in files if not f.name.endswith(".tmp.npz")]
     if not files:
         raise InputError(f"data: no shards in {path}; run `gdnplan generate` first")

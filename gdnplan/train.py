@@ -249,6 +249,7 @@ def train(
     data_root: Path | str = DATA_DIR,
     out: Path | str | None = None,
     run_dir: Path | str | None = None,
+    compile: bool = False,
 ) -> dict:
     """Train GraphDistNet on ``data/<env>/train``, evaluate on ``data/<env>/test``, save weights.
 
@@ -260,6 +261,8 @@ def train(
         time_budget: stop after this many seconds of training (s).
         device: ``"cpu"`` or ``"cuda"``.
         out: weights path (default ``weights/<env>.safetensors``; the card goes beside it).
+        compile: ``torch.compile`` the training step (≈ 3× faster on CPU after a few minutes
+            of compilation); validation and evaluation stay eager.
 
     Returns:
         The card written beside the weights (config, data, training log, test metrics).
@@ -278,6 +281,7 @@ def train(
     train_t = tensors(full.subset(order[n_val:]), config)
     val_t = tensors(full.subset(order[:n_val]), config)
     net = GraphDistNet(config).to(device)
+    step_net = torch.compile(net, dynamic=True) if compile else net
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     ckpt = run_dir / "checkpoint.safetensors"
     state = {"epoch": 0, "lr": lr, "best": math.inf, "stale": 0, "plateau": 0, "log": []}
@@ -305,13 +309,13 @@ def train(
             d = train_t.d[rows].to(device)
             if config.grad_weight > 0:
                 jac = train_t.jac[rows].to(device)
-                d_hat, g_hat = forward_with_grad(net, robot_b, obst_b, jac, True, gen)
+                d_hat, g_hat = forward_with_grad(step_net, robot_b, obst_b, jac, True, gen)
                 g = train_t.grad[rows].to(device)
                 ok = (g.norm(dim=1) > 1e-9).float()
                 cos = torch.nn.functional.cosine_similarity(g_hat, g, dim=1, eps=1e-9)
                 loss_g = ((1 - cos) * ok).sum() / ok.sum().clamp_min(1)
             else:
-                d_hat, loss_g = net(robot_b, obst_b, gen), torch.zeros((), device=device)
+                d_hat, loss_g = step_net(robot_b, obst_b, gen), torch.zeros((), device=device)
             loss = ((d_hat - d) / config.scale).square().mean() + config.grad_weight * loss_g
             opt.zero_grad()
             loss.backward()
@@ -372,6 +376,7 @@ def train(
             "samples_per_s": float(np.mean([e["samples_per_s"] for e in log])),
             "device": device,
             "threads": torch.get_num_threads(),
+            "compiled": compile,
         },
         "parameters": sum(p.numel() for p in net.parameters()),
         "test": test,
@@ -420,6 +425,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--device", default="cpu")
     p.add_argument("--threads", type=int, default=1)
     p.add_argument("--out", default=None)
+    p.add_argument("--compile", action="store_true", help="torch.compile the training step")
     a = p.parse_args(argv)
     torch.set_num_threads(a.threads)
     overrides = {k: json.loads(v) for k, v in (s.split("=", 1) for s in a.set)}
@@ -437,6 +443,7 @@ def main(argv: list[str] | None = None) -> None:
         a.seed,
         a.device,
         out=a.out,
+        compile=a.compile,
     )
     print(json.dumps({"env": a.env, "name": card["name"], **card["test"]}, indent=2))
 

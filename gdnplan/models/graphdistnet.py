@@ -312,21 +312,29 @@ class GraphDistNetModel:
 
     ∂d̂/∂q = Σ_n (∂d̂/∂p_n) ∂p_n/∂q: autograd on the robot node coordinates p_n (B, N, 2)
     chained with the node Jacobians (B, N, 2, dof) of :class:`~gdnplan.graph.RobotGraph`.
-    Computation is float32 in chunks of ``chunk`` samples; results are float64.
+    Computation is in ``dtype`` (float32 by default) in chunks of ``chunk`` samples; results
+    are float64.
     """
 
     name = "graphdistnet"
 
-    def __init__(self, net: GraphDistNet, card: dict | None = None, chunk: int = 256):
-        self.net = net.eval()
+    def __init__(
+        self,
+        net: GraphDistNet,
+        card: dict | None = None,
+        chunk: int = 256,
+        dtype: torch.dtype = torch.float32,
+    ):
+        self.net = net.to(dtype).eval()
         self.config = net.config
         self.card = card or {}
         self.chunk = chunk
+        self.dtype = dtype
 
     def _graphs(self, scene: Scene):
         graph = robot_graph(scene.robot, self.config.max_edge)
         polys, sizes = scene_obstacles([scene])
-        obstacles = obstacle_graph(polys, sizes, self.config.max_edge)
+        obstacles = obstacle_graph(polys, sizes, self.config.max_edge, dtype=self.dtype)
         return graph, obstacles
 
     def _generator(self) -> torch.Generator | None:
@@ -341,7 +349,7 @@ class GraphDistNetModel:
         with torch.inference_mode():
             for s in range(0, len(q), self.chunk):
                 nodes = graph.positions(q[s : s + self.chunk])
-                rb = graph.batch(nodes)
+                rb = graph.batch(nodes, dtype=self.dtype)
                 ob = _repeat(obstacles, len(nodes))
                 out.append(self.net(rb, ob, gen).double().numpy())
         return np.concatenate(out)
@@ -354,9 +362,9 @@ class GraphDistNetModel:
         ds, gs = [], []
         for s in range(0, len(q), self.chunk):
             nodes, jac = graph.positions_and_jacobians(q[s : s + self.chunk])
-            x = torch.tensor(nodes, dtype=torch.float32, requires_grad=True)
+            x = torch.tensor(nodes, dtype=self.dtype, requires_grad=True)
             with torch.enable_grad():
-                d = self.net(graph.batch(x), _repeat(obstacles, len(nodes)), gen)
+                d = self.net(graph.batch(x, dtype=self.dtype), _repeat(obstacles, len(nodes)), gen)
                 (dx,) = torch.autograd.grad(d.sum(), x)
             ds.append(d.detach().double().numpy())
             gs.append(np.einsum("bni,bnij->bj", dx.double().numpy(), jac))

@@ -1,0 +1,153 @@
+"""GraphDistNet: gradients, determinism, invariances, continuity, shipped weights, bad input."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+import gdnplan as gp
+from gdnplan.data import load
+from gdnplan.models.graphdistnet import GraphDistNet, GraphDistNetConfig, GraphDistNetModel
+from gdnplan.train import evaluate
+
+ROOT = Path(__file__).resolve().parent.parent
+WEIGHTS = ROOT / "weights"
+TEST_DATA = Path(__file__).resolve().parent / "data"
+
+# metrics of the shipped weights on the committed 300-sample test splits must stay within these
+SHIPPED = {  # env: (max MAE m, min AUC, max ACD)
+    "a": (0.03, 0.99, 0.35),
+    "b": (0.03, 0.99, 0.35),
+    "c": (0.08, 0.95, 0.6),
+    "d": (0.12, 0.85, 0.8),
+    "e": (0.15, 0.85, 0.8),
+}
+
+
+def random_model(env: str, dtype=torch.float32, **changes) -> tuple[gp.Scene, GraphDistNetModel]:
+    scene = gp.make_scene(env, seed=5)
+    torch.manual_seed(0)
+    config = GraphDistNetConfig.smooth(scale=scene.robot.reach, **changes)
+    return scene, GraphDistNetModel(GraphDistNet(config), dtype=dtype)
+
+
+@pytest.mark.parametrize("changes", [{}, {"activation": "silu", "max_edge": 0.1}])
+def test_autograd_gradient_matches_finite_differences(changes):
+    scene, model = random_model("e", torch.float64, **changes)
+    q = scene.robot.sample(3, seed=2)
+    d, g = model.distance_and_grad(scene, q)
+    eps = 1e-6
+    fd = np.stack(
+        [
+            (model.distance(scene, q + eps * e) - model.distance(scene, q - eps * e)) / (2 * eps)
+            for e in np.eye(scene.robot.dof)
+        ],
+        1,
+    )
+    np.testing.assert_allclose(g, fd, atol=1e-8 * max(1.0, np.abs(g).max()), rtol=1e-5)
+    np.testing.assert_allclose(d, model.distance(scene, q))
+
+
+def test_batch_equals_per_sample_and_is_deterministic():
+    scene, model = random_model("d")
+    q = scene.robot.sample(6, seed=3)
+    d_batch = model.distance(scene, q)
+    d_single = np.array([model.distance(scene, qi)[0] for qi in q])
+    np.testing.assert_allclose(d_batch, d_single, atol=1e-6)
+    np.testing.assert_array_equal(d_batch, model.distance(scene, q))
+    _, g1 = model.distance_and_grad(scene, q)
+    _, g2 = model.distance_and_grad(scene, q)
+    np.testing.assert_array_equal(g1, g2)
+
+
+def test_permuting_obstacles_and_start_vertices_keeps_distance():
+    scene, model = random_model("e")
+    q = scene.robot.sample(5, seed=4)
+    rng = np.random.default_rng(0)
+    shuffled = [np.roll(scene.obstacles[i], rng.integers(1, 5), 0) for i in rng.permutation(5)]
+    d = model.distance(scene, q)
+    np.testing.assert_allclose(model.distance(scene.with_obstacles(shuffled), q), d, atol=1e-5)
+
+
+def test_lean_first_layer_equals_naive_per_edge_reference():
+    torch.manual_seed(1)
+    scene, model = random_model("b")
+    net = model.net
+    from gdnplan.graph import obstacle_graph, robot_graph, scene_obstacles
+
+    q = scene.robot.sample(4, seed=0)
+    robot = robot_graph(scene.robot).batch(robot_graph(scene.robot).positions(q))
+    polys, sizes = scene_obstacles([scene] * 4)
+    g = net.union(robot, obstacle_graph(polys, sizes))
+    idx, w = net.cross_weights(g, None, 0, net.candidates(g), None)
+    h = torch.randn(*g.x0.shape[:2], net.config.hidden)
+    for k, z in ((0, g.x0), (1, torch.cat([g.x0, h], -1))):
+        lean = net.edge_preactivation(k, z, g.nbr, idx, w)
+        b = z.shape[0]
+        z_j = torch.stack([z[torch.arange(b)[:, None], g.nbr[..., e]] for e in range(3)], 2)
+        z_c = z[torch.arange(b)[:, None, None], idx]  # (B, N, C, D)
+        z_bar = (w[..., None] * z_c).sum(2)
+        feat = torch.cat([z_j - z[:, :, None], (z_bar - z)[:, :, None].expand(-1, -1, 3, -1)], -1)
+        naive = net.convs[k][0](feat)
+        torch.testing.assert_close(lean, naive, atol=1e-5, rtol=1e-5)
+
+
+def sweep_jumps(model, scene: gp.Scene, joints: list[int], n: int = 200) -> np.ndarray:
+    """Largest |Δd̂| (m) between consecutive 0.003 rad steps along sweeps of each joint."""
+    robot = scene.robot
+    q0 = robot.sample(1, seed=7)[0]
+    out = []
+    for j in joints:
+        q = np.repeat(q0[None], n, 0)
+        q[:, j] = np.clip(q0[j] - 0.3 + 0.003 * np.arange(n), robot.lower[j], robot.upper[j])
+        out.append(np.abs(np.diff(model.distance(scene, q))).max())
+    return np.array(out)
+
+
+def shipped(name: str) -> GraphDistNetModel:
+    path = WEIGHTS / f"{name}.safetensors"
+    if not path.exists():
+        pytest.skip(f"{path.name} not trained yet")
+    return gp.load_model(path)
+
+
+@pytest.mark.parametrize("env", ["b", "d"])
+def test_shipped_default_is_continuous_along_joint_sweeps(env):
+    model = shipped(env)
+    assert model.config.cross == "soft_knn"
+    scene = gp.make_scene(env, seed=11)
+    assert sweep_jumps(model, scene, list(range(scene.robot.dof))[:3]).max() < 0.01
+
+
+@pytest.mark.xfail(reason="expected finding: the paper's random/argmax partners make d̂ jump")
+def test_faithful_variant_jumps_along_joint_sweeps():
+    model = shipped("b_faithful")
+    scene = gp.make_scene("b", seed=11)
+    assert sweep_jumps(model, scene, [0, 1]).max() < 0.01
+
+
+@pytest.mark.parametrize("env", sorted(SHIPPED))
+def test_shipped_weights_on_committed_test_split(env):
+    model = shipped(env)
+    m = evaluate(model.net, load(TEST_DATA / f"{env}_test.npz"))
+    max_mae, min_auc, max_acd = SHIPPED[env]
+    assert m["mae_m"] <= max_mae and m["auc"] >= min_auc and m["acd"] <= max_acd, m
+
+
+def test_bad_inputs_raise_input_error():
+    scene, model = random_model("a")
+    with pytest.raises(gp.InputError):
+        model.distance(scene, np.zeros((2, 3)))
+    with pytest.raises(gp.InputError):
+        model.distance_and_grad(scene, np.array([np.nan, 0.0]))
+    with pytest.raises(gp.InputError):
+        model.distance(scene.with_obstacles([]), np.zeros(2))
+    with pytest.raises(gp.InputError):
+        GraphDistNetConfig(cross="nearest")
+    with pytest.raises(gp.InputError):
+        GraphDistNetConfig(activation="relu")
+    with pytest.raises(gp.InputError):
+        GraphDistNetConfig.from_dict({"layers": 2, "width": 3})
+    with pytest.raises(gp.InputError):
+        gp.load_model(WEIGHTS / "nonexistent.safetensors")
