@@ -293,7 +293,9 @@ def train(
     return ClearanceNetModel(net, card)
 
 
-def train_and_save(env: str, time_budget: float = 120.0, out: Path | str | None = None) -> dict:
+def train_and_save(
+    env: str, time_budget: float = 120.0, patience: int = 10, out: Path | str | None = None
+) -> dict:
     """Train on ``data/<env>/train``, score on the test split, write ``weights/clearancenet_<env>``.
 
     Returns the card (training log summary and test metrics: n, MAE (m), AUC, ACD).
@@ -302,11 +304,12 @@ def train_and_save(env: str, time_budget: float = 120.0, out: Path | str | None 
     from ..evaluate import WEIGHTS_DIR, evaluate_model
 
     torch.set_num_threads(1)
-    model = train(env, load(split_dir(env, "train")), time_budget=time_budget)
+    model = train(env, load(split_dir(env, "train")), patience=patience, time_budget=time_budget)
     r = evaluate_model(model, env, n=5000)
     model.card["test"] = {"n": r.n, "mae_m": r.mae, "auc": r.auc, "acd": r.acd, "n_grad": r.n_grad}
     model.card["command"] = (
-        f"python -m gdnplan.models.clearancenet {env} --time-budget {time_budget:g}"
+        f"python -m gdnplan.models.clearancenet {env} --time-budget {time_budget:g} "
+        f"--patience {patience}"
     )
     model.save(out or WEIGHTS_DIR / f"clearancenet_{env}.safetensors")
     return model.card
@@ -318,7 +321,8 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description="Train ClearanceNet baselines (Table I).")
     parser.add_argument("envs", nargs="+", choices=["a", "b", "c", "d", "e"])
     parser.add_argument("--time-budget", type=float, default=120.0, help="seconds per env")
+    parser.add_argument("--patience", type=int, default=10, help="epochs without improvement")
     args = parser.parse_args()
     for env in args.envs:
-        card = train_and_save(env, args.time_budget)
+        card = train_and_save(env, args.time_budget, args.patience)
         print(env, json.dumps({"training": card["training"], "test": card["test"]}))
