@@ -486,7 +486,8 @@ Notes (how each number is made; `paper` columns are the paper's Table I):
   w/ AL: active learning on the scenes of the first 10 test samples (relabel support points,
   2 Gaussian perturbations each, 2000 uniform samples, continue the perceptron); AUC and ACD
   pool 200 uniform configurations per adapted scene; time = mean adaptation time per scene
-  × n (extrapolated, as the paper adapts to every test scene).
+  × n (extrapolated, as the paper adapts to every test scene). The paper's DiffCo w/ AL ran out
+  of memory in e, hence no paper numbers there.
 - ClearanceNet: MLP 3×256 ReLU on [q/π, obstacle poses (centre, cos 4θ, sin 4θ) or padded
   α-shape vertices], dropout 0.5 for d and e, Adam on data/<env>/train (weights card: data,
   epochs, seconds); a 120 s training budget per environment on this CPU.
