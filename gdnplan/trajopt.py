@@ -146,6 +146,13 @@ class Problem:
                     f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m; "
                     "move it away from the obstacles or lower options.margin"
                 )
+        if self.goal is not None:
+            blocked = first_joint_barrier(self.scene, self.start[0], self.goal[0])
+            if blocked is not None:
+                raise InfeasibleProblemError(
+                    f"start.q[0] -> goal.q[0]: the first link collides at joint 1 = {blocked:.3f} "
+                    "rad, which every motion between them must pass (joints do not wrap)"
+                )
         if self.goal_position is not None:
             robot = self.scene.robot
             r = float(np.linalg.norm(self.goal_position - robot.chain.joint_origins[0]))
@@ -224,6 +231,25 @@ def _vector(value, n: int, name: str) -> np.ndarray:
     return v
 
 
+def first_joint_barrier(scene: Scene, a: float, b: float, n: int = 200) -> float | None:
+    """A joint-1 angle between a and b (rad) where the links moved by joint 1 alone collide,
+    or None when none of n samples does.
+
+    Links on body 1 depend on q_1 only and joints do not wrap, so every path from q_1 = a to
+    q_1 = b passes each angle between them in the same link pose: a collision there proves the
+    problem infeasible. (Only a necessary condition is tested; None proves nothing.)
+    """
+    robot = scene.robot
+    first = [k for k, p in enumerate(robot.polygons) if p.body == 1]
+    if not first:
+        return None
+    q = np.zeros((n, robot.dof))
+    q[:, 0] = np.linspace(a, b, n)
+    d = signed_distance(scene, q, per_link=True)[:, first].min(axis=1)
+    hit = np.flatnonzero(d <= 0)
+    return float(q[hit[0], 0]) if hit.size else None
+
+
 # -------------------------------------------------------------------- goal position -> q
 def solve_ik(
     problem: Problem, seed: int = 0, restarts: int = 64, iterations: int = 100
@@ -249,6 +275,8 @@ def solve_ik(
     ok = err <= problem.goal_tolerance / 2
     if ok.any():
         ok[ok] = signed_distance(problem.scene, q[ok]) > problem.margin
+    for i in np.flatnonzero(ok):
+        ok[i] = first_joint_barrier(problem.scene, problem.start[0], q[i, 0], n=50) is None
     if not ok.any():
         raise InfeasibleProblemError(
             f"goal.position {target.tolist()}: no collision-free joint configuration within the "
@@ -274,6 +302,9 @@ class TrajoptOptions:
         starts: Ipopt attempts (new seed path each) before giving up.
         max_iter: Ipopt iteration cap per attempt.
         tol: Ipopt tolerance.
+        obj_change_tol: Ipopt also stops ("acceptable") once the relative change of the path
+            cost stays below this for 3 iterations at a feasible point (constraint violation
+            ≤ 1e-5): the certified check, not the KKT residual, judges the result.
         rrt_clearance: extra clearance (m) above the margin demanded of seed paths.
         rrt_time: time limit of one RRT-Connect run (s).
         link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
@@ -289,6 +320,7 @@ class TrajoptOptions:
     starts: int = 3
     max_iter: int = 150
     tol: float = 1e-3
+    obj_change_tol: float = 1e-4
     rrt_clearance: float = 0.02
     rrt_time: float = 5.0
     link_cap: float = 0.3
@@ -544,7 +576,7 @@ class _Transcription:
             "tol": opts.tol,
             "acceptable_tol": 1e3,  # stop on objective stagnation + feasibility
             "acceptable_iter": 3,
-            "acceptable_obj_change_tol": 1e-4,
+            "acceptable_obj_change_tol": opts.obj_change_tol,
             "acceptable_constr_viol_tol": 1e-5,
             "mu_strategy": "adaptive",
         }
@@ -634,6 +666,7 @@ __all__ = [
     "Problem",
     "TrajoptOptions",
     "collision_cost",
+    "first_joint_barrier",
     "path_cost",
     "plan",
     "solve_ik",

@@ -112,6 +112,7 @@ def test_from_toml_roundtrip(tmp_path, square):
         ("[0.7, 0.0]", "q = [1.0, 0.0]", "", gp.InfeasibleProblemError, "start.q is in collision"),
         ("[0.0, 0.0]", "position = [2.0, 0.5]", "", gp.InfeasibleProblemError, "out of reach"),
         ("[0.0, 0.0]", "q = [4.0, 0.0]", "", gp.InfeasibleProblemError, "joint limits"),
+        ("[0.0, 0.0]", "q = [1.4, 0.0]", "", gp.InfeasibleProblemError, "first link collides"),
     ],
 )
 def test_bad_problem_files_raise_named_errors(tmp_path, start, goal, extra, error, match):
