@@ -37,13 +37,14 @@ from .casadi_bridge import DistanceCallback, supports_per_link
 from .ccd import certify_path, verify_path
 from .distance import signed_distance
 from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
-from .models import CoalModel, DistanceModel
+from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot
 from .rrt import seed_path
 from .scene import Scene, scene_from_config
 
 WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
 TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options"}
+INITIAL_GUESSES = ("auto", "straight", "rrt")
 SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
 OPTION_KEYS = {"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"}
 
@@ -325,7 +326,7 @@ class TrajoptOptions:
     rrt_time: float = 5.0
     link_cap: float = 0.3
     adam_iterations: int = 500
-    adam_lr: float = 0.01
+    adam_lr: float = 0.05
     adam_c: float = 1e-3
     adam_eps: float = 1e-3
     adam_stop: float = 0.01
@@ -384,11 +385,7 @@ def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | P
             f"weights: {path} does not exist; train GraphDistNet for environment "
             f"{scene.name!r} first or pass weights=<file.safetensors>"
         )
-    from . import models
-
-    if not hasattr(models, "load_model"):
-        raise InputError("collision='graphdistnet': this version has no GraphDistNet loader")
-    return models.load_model(path)
+    return load_model(path)
 
 
 def plan(
@@ -405,6 +402,8 @@ def plan(
     """
     t0 = time.perf_counter()
     opts = options or TrajoptOptions()
+    if opts.initial not in INITIAL_GUESSES:
+        raise InputError(f"initial: unknown {opts.initial!r}; choose one of {INITIAL_GUESSES}")
     model = resolve_model(collision, problem.scene, weights)
     goal = problem.goal if problem.goal is not None else solve_ik(problem, seed)
     if solver == "ipopt":
@@ -634,20 +633,28 @@ def collision_cost(
 
 def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -> _Run:
     """Adam on the interior waypoints of Σ_k C(d(p_k)) + Σ_t ‖q_{t+1} − q_t‖², from the
-    straight line, until every check point has d ≥ margin + adam_stop or the iteration cap."""
+    straight line, until the collision cost falls below the threshold — every term below
+    C(margin + adam_stop), i.e. min_k d(p_k) ≥ margin + adam_stop as C decreases above the
+    margin — or the iteration cap. With ``ccd``, reaching the threshold triggers the continuous
+    certificate; uncertified segments get twice the check points and Adam continues."""
     T = problem.waypoints
-    W = _interpolation_matrix(np.full(T - 1, opts.interpolated + 1))
+    splits = np.full(T - 1, opts.interpolated + 1)
+    W = _interpolation_matrix(splits)
     q = straight_line(problem.start, goal, T)
     m, v = np.zeros_like(q), np.zeros_like(q)
     b1, b2 = 0.9, 0.999
-    calls, status = 0, "adam: iteration cap"
+    calls, refinements, status = 0, 0, "adam: iteration cap"
     for it in range(1, opts.adam_iterations + 1):
-        P = W @ q
-        d, g = model.distance_and_grad(problem.scene, P)
+        d, g = model.distance_and_grad(problem.scene, W @ q)
         calls += 1
         if np.min(d) >= problem.margin + opts.adam_stop:
-            status = "adam: cost below threshold"
-            break
+            cert = certify_path(problem.scene, q) if opts.ccd else None
+            if cert is None or cert.ok or refinements == opts.refine_rounds:
+                status = "adam: cost below threshold"
+                break
+            splits[list(cert.bad_segments)] *= 2
+            W, refinements = _interpolation_matrix(splits), refinements + 1
+            continue
         _, dc = collision_cost(np.asarray(d), problem.margin, opts.adam_c, opts.adam_eps)
         grad = W.T @ (dc[:, None] * g)
         grad[1:] += 2 * (q[1:] - q[:-1])

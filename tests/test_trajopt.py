@@ -67,10 +67,11 @@ def test_solver_failure_returns_unsuccessful_plan_with_reason(square):
     assert "Maximum_Iterations_Exceeded" in result.reason and "not certified" in result.reason
 
 
-def test_adam_returns_a_plan(square):
-    p = Problem(scene=square, start=[-1.0, 0.0], goal=[-2.0, 0.5], waypoints=10)
+def test_adam_pushes_the_straight_line_out_of_the_square(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=20)
     result = plan(p, solver="adam")
-    assert result.success and result.status.startswith("adam")
+    assert result.success, result.reason
+    assert result.status == "adam: cost below threshold" and result.iterations > 1
 
 
 TOML = """
