@@ -170,9 +170,10 @@ def seed_path(
     clearance: float,
     seed: int = 0,
     time_limit: float = 10.0,
+    step: float = 2.0,
 ) -> tuple[np.ndarray | None, RRTResult]:
     """RRT-Connect + shortcut + resample: (n_waypoints, dof) seed, or None on failure."""
-    res = rrt_connect(scene, start, goal, clearance, seed=seed, time_limit=time_limit)
+    res = rrt_connect(scene, start, goal, clearance, step=step, seed=seed, time_limit=time_limit)
     if not res.success:
         return None, res
     path = shortcut(scene, res.path, clearance, seed=seed)

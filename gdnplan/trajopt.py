@@ -306,8 +306,11 @@ class TrajoptOptions:
         obj_change_tol: Ipopt also stops ("acceptable") once the relative change of the path
             cost stays below this for 3 iterations at a feasible point (constraint violation
             ≤ 1e-5): the certified check, not the KKT residual, judges the result.
-        rrt_clearance: extra clearance (m) above the margin demanded of seed paths.
+        rrt_clearance: extra clearance (m) above the margin demanded of seed paths (at most
+            half the start's and goal's own clearance above the margin).
         rrt_time: time limit of one RRT-Connect run (s).
+        rrt_step: RRT-Connect extension (rad, joint-space 2-norm) of the first attempt; each
+            restart divides it by 3 (long steps win in open clutter, short ones in passages).
         link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
         adam_iterations, adam_lr, adam_c, adam_eps, adam_stop: the paper's Adam optimiser:
             iteration cap, step size (rad), cost constant c, ε, and the stop clearance (m).
@@ -324,6 +327,7 @@ class TrajoptOptions:
     obj_change_tol: float = 1e-4
     rrt_clearance: float = 0.02
     rrt_time: float = 5.0
+    rrt_step: float = 2.0
     link_cap: float = 0.3
     adam_iterations: int = 500
     adam_lr: float = 0.05
@@ -470,6 +474,9 @@ def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
     line = straight_line(problem.start, goal, problem.waypoints)
     use_line = opts.initial == "straight"
     rng = np.random.default_rng(seed)
+    # seed edges must clear margin + rrt_clearance, but never more than the ends allow
+    ends = float(np.min(signed_distance(problem.scene, np.stack([problem.start, goal]))))
+    clearance = problem.margin + min(opts.rrt_clearance, (ends - problem.margin) / 2)
     for attempt in range(opts.starts):
         if use_line:
             guess = line.copy()
@@ -483,11 +490,12 @@ def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
             problem.start,
             goal,
             problem.waypoints,
-            problem.margin + opts.rrt_clearance,
+            clearance,
             seed=seed + attempt,
             time_limit=opts.rrt_time,
+            step=opts.rrt_step / 3**attempt,
         )
-        yield f"RRT-Connect seed {seed + attempt}", guess
+        yield f"RRT-Connect seed {seed + attempt} (step {opts.rrt_step / 3**attempt:.2g})", guess
 
 
 def _line_free(problem: Problem, line: np.ndarray) -> bool:
