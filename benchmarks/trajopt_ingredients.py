@@ -129,6 +129,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", type=Path, default=ROOT / "results" / "trajopt_ingredients.md")
     args = ap.parse_args()
+    host = machine()  # git sha of the code that runs, taken before the (long) run
     problems = make_problems(args.n, args.seed)
     rows = []
     for name, opts in VARIANTS.items():
@@ -141,7 +142,7 @@ def main() -> None:
         "between checks) + goal reached. Time = whole `plan` call (seed search, all Ipopt "
         "attempts, verification).\n\n"
         f"{table(rows)}\n\n"
-        f"- machine: {machine()}\n"
+        f"- machine: {host}; load average at the end {os.getloadavg()[0]:.1f} (shared CPUs)\n"
         f"- command: `.venv/bin/python benchmarks/trajopt_ingredients.py --n {args.n} "
         f"--seed {args.seed}`\n"
         f"- date: {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC\n"
