@@ -475,7 +475,8 @@ Notes (how each number is made; `paper` columns are the paper's Table I):
   left out. AUC: positives are coal's f ≤ 0, the score is −d̂.
 - Time: fastest of 3 wall times of the distance batch on this shared 2-core CPU (coal: one run,
   one call per obstacle set including building its coal shapes; learned models: one batched
-  pass, GraphDistNet including graph construction). The paper timed a GPU for the networks.
+  pass on one torch thread, GraphDistNet including graph construction). Other jobs shared the
+  CPU, so times vary between runs by up to ~10×. The paper timed a GPU for the networks.
 - MAE [/reach]: metres, and as a fraction of the arm's reach (1.2 m planar2, 2.1 m planar7).
   p (GraphDistNet row): two-sided Welch's t-test between GraphDistNet's and ClearanceNet's
   absolute errors, with the method whose MAE is lower.
@@ -537,6 +538,9 @@ def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> st
 
 def table1(envs: tuple[str, ...] = ENVS, fast: bool = False, log=print):
     """Run Table I; returns {env: (rows, p)}. ``fast`` uses :meth:`TableSettings.fast`."""
+    import torch
+
+    torch.set_num_threads(1)  # stable timings on a shared CPU; every network gets one thread
     s = TableSettings.fast() if fast else TableSettings()
     out = {}
     for env in envs:
