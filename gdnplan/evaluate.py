@@ -540,12 +540,16 @@ def table1(envs: tuple[str, ...] = ENVS, fast: bool = False, log=print):
     """Run Table I; returns {env: (rows, p)}. ``fast`` uses :meth:`TableSettings.fast`."""
     import torch
 
+    threads = torch.get_num_threads()
     torch.set_num_threads(1)  # stable timings on a shared CPU; every network gets one thread
     s = TableSettings.fast() if fast else TableSettings()
     out = {}
-    for env in envs:
-        out[env] = table1_env(env, s)
-        log(f"env {env}: " + ", ".join(r.method for r in out[env][0]))
+    try:
+        for env in envs:
+            out[env] = table1_env(env, s)
+            log(f"env {env}: " + ", ".join(r.method for r in out[env][0]))
+    finally:
+        torch.set_num_threads(threads)
     missing = [
         f"{name} {env}"
         for env in envs
