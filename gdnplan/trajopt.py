@@ -36,7 +36,7 @@ import pinocchio as pin
 from .casadi_bridge import DistanceCallback, supports_per_link
 from .ccd import certify_path, verify_path
 from .distance import signed_distance
-from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
+from .errors import InfeasibleProblemError, InputError, ProblemFileError
 from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot
 from .rrt import seed_path
@@ -309,8 +309,8 @@ class TrajoptOptions:
         rrt_clearance: extra clearance (m) above the margin demanded of seed paths (at most
             half the start's and goal's own clearance above the margin).
         rrt_time: time limit of one RRT-Connect run (s).
-        rrt_step: RRT-Connect extension (rad, joint-space 2-norm) of the first attempt; each
-            restart divides it by 3 (long steps win in open clutter, short ones in passages).
+        rrt_step: RRT-Connect extension (rad, joint-space 2-norm); long steps were fastest on
+            environment (d), narrow passages (fetch) may need ~0.3.
         link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
         adam_iterations, adam_lr, adam_c, adam_eps, adam_stop: the paper's Adam optimiser:
             iteration cap, step size (rad), cost constant c, ε, and the stop clearance (m).
@@ -493,9 +493,9 @@ def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
             clearance,
             seed=seed + attempt,
             time_limit=opts.rrt_time,
-            step=opts.rrt_step / 3**attempt,
+            step=opts.rrt_step,
         )
-        yield f"RRT-Connect seed {seed + attempt} (step {opts.rrt_step / 3**attempt:.2g})", guess
+        yield f"RRT-Connect seed {seed + attempt}", guess
 
 
 def _line_free(problem: Problem, line: np.ndarray) -> bool:
@@ -548,7 +548,8 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
 
 
 class _Transcription:
-    """The NLP of the module docstring, built once and solved from several initial guesses."""
+    """The NLP of the module docstring for one set of check points (segment t split in
+    ``splits[t]`` pieces); rebuilt when the certificate refines them."""
 
     def __init__(self, problem: Problem, model: DistanceModel, goal, opts, splits: np.ndarray):
         robot = problem.scene.robot
@@ -676,7 +677,6 @@ def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -
 
 
 __all__ = [
-    "GdnplanError",
     "Plan",
     "Problem",
     "TrajoptOptions",
