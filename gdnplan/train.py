@@ -5,10 +5,11 @@ Loss per sample (distances normalised by the config's ``scale`` = reach):
     L = ((d̂ − f) / scale)² + λ · (1 − cos(∂d̂/∂q, ∂f/∂q))      (λ = ``grad_weight``, 0 = paper)
 
 with ∂d̂/∂q = Σ_n (∂d̂/∂p_n) ∂p_n/∂q (node Jacobians). Adam, a validation split (10 % of
-train), learning rate halved after 3 epochs without improvement, early stopping after
-``patience`` epochs, an optional wall-clock budget. Each epoch writes a checkpoint (safetensors +
-JSON) in the run directory, so an interrupted run resumes where it stopped; the epoch order is
-a function of (seed, epoch), hence runs are deterministic on one device.
+train) scored by the loss's terms (MAE/scale + λ · ACD), learning rate halved after 3 epochs
+without improvement, early stopping after ``patience`` epochs, an optional wall-clock budget.
+Each epoch writes a checkpoint (safetensors + JSON) in the run directory, so an interrupted run
+resumes where it stopped; the epoch order is a function of (seed, epoch), hence runs are
+deterministic on one device.
 
 Metrics (:func:`evaluate`, paper Table I), against coal labels on a held-out split:
 
@@ -324,20 +325,25 @@ def train(
             bar.set_postfix(loss=f"{float(loss.detach()):.2e}", refresh=False)
         seconds = time.perf_counter() - start
         trained += seconds
-        val_hat, _ = predict(net, val_t, device=device, grad=False)
+        val_hat, val_g = predict(net, val_t, device=device, grad=config.grad_weight > 0)
         val_mae = float(np.mean(np.abs(val_hat - val_t.d.double().numpy())))
+        score = val_mae / config.scale  # model selection: the loss's terms on validation
+        if val_g is not None:
+            acd, _ = mean_cosine_distance(val_g, val_t.grad.double().numpy())
+            score += config.grad_weight * acd
         entry = {
             "epoch": epoch,
             "train_loss": total / n,
             "val_mae_m": val_mae,
+            "val_score": score,
             "lr": state["lr"],
             "seconds": seconds,
             "samples_per_s": n / seconds,
         }
         state["log"].append(entry)
         print(json.dumps(entry))
-        if val_mae < state["best"]:
-            state.update(best=val_mae, stale=0, plateau=0)
+        if score < state["best"]:
+            state.update(best=score, stale=0, plateau=0)
             state["best_state"] = {k: v.detach().clone() for k, v in net.state_dict().items()}
         else:
             state["stale"] += 1
@@ -371,7 +377,7 @@ def train(
             "batch": batch,
             "lr": lr,
             "epochs": len(log),
-            "best_val_mae_m": state["best"],
+            "best_val_score": state["best"],
             "seconds": sum(e["seconds"] for e in log),
             "samples_per_s": float(np.mean([e["samples_per_s"] for e in log])),
             "device": device,

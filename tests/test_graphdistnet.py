@@ -32,10 +32,10 @@ def random_model(env: str, dtype=torch.float32, **changes) -> tuple[gp.Scene, Gr
     return scene, GraphDistNetModel(GraphDistNet(config), dtype=dtype)
 
 
-@pytest.mark.parametrize("changes", [{}, {"activation": "silu", "max_edge": 0.1}])
+@pytest.mark.parametrize("changes", [{}, {"activation": "silu", "max_edge": 0.25}])
 def test_autograd_gradient_matches_finite_differences(changes):
     scene, model = random_model("e", torch.float64, **changes)
-    q = scene.robot.sample(3, seed=2)
+    q = scene.robot.sample(2, seed=2)
     d, g = model.distance_and_grad(scene, q)
     eps = 1e-6
     fd = np.stack(

@@ -195,7 +195,7 @@ class GraphDistNet(nn.Module):
         """
         n_r = g.n_robot
         xr, xo = g.x0[:, :n_r], g.x0[:, n_r:]
-        d2 = torch.cdist(xr, xo).square()  # (B, N_r, N_o)
+        d2 = (xr[:, :, None] - xo[:, None]).square().sum(-1)  # (B, N_r, N_o), twice differentiable
         d2 = d2.masked_fill(~g.mask[:, None, n_r:], PAD_DIST2)
         d2 = d2.masked_fill(~g.mask[:, :n_r, None], PAD_DIST2)
         c = min(self.config.cross_k + 1, max(d2.shape[1:]))
