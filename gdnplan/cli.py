@@ -191,6 +191,7 @@ def table1_command(
         f"- machine: {platform.node()}, {cpu}, {os.cpu_count()} cores (shared), "
         f"{platform.python_version()}",
         f"- missing weights: {', '.join(missing) if missing else 'none'}",
+        f"- weights used (sha256 prefix): {ev.weights_fingerprint(tuple(envs))}",
         "",
         "",
     ]

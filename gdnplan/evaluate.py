@@ -623,3 +623,15 @@ def table1_figures(results: dict[str, tuple[list[Result], float | None]], out_di
     save_figure(roc_figure(curves), paths[0])
     save_figure(scatter_figure(points), paths[1])
     return paths
+
+
+def weights_fingerprint(envs: tuple[str, ...]) -> str:
+    """``name:sha256[:10]`` of every ClearanceNet / GraphDistNet weights file a table run uses."""
+    import hashlib
+
+    names = [f"clearancenet_{e}.safetensors" for e in envs] + [f"{e}.safetensors" for e in envs]
+    return ", ".join(
+        f"{n}:{hashlib.sha256((WEIGHTS_DIR / n).read_bytes()).hexdigest()[:10]}"
+        for n in names
+        if (WEIGHTS_DIR / n).exists()
+    )
