@@ -11,6 +11,19 @@ so a split is a pure function of (env, seed, n) and train (seed 0) and test (see
 share a scene. Shards of ``SHARD_SIZE`` samples are written by a pool of processes, each to a
 temporary file renamed when complete; re-running skips shards that exist.
 
+The ``ur5e`` environment (the fetch robot, paper §V-C) varies the robot as well: each sample
+draws a gripper state (open, closed, holding), a storage layout and 1–3 random boxes around
+it. Building a random fetch layout searches for free grasps (≈ 45 ms), so each split draws its
+layouts from a fixed pool of ``UR5E_LAYOUTS`` fetch seeds
+
+    layout_seed = FETCH_SEED_BASE + seed · 10⁶ + k,   k = 0 … UR5E_LAYOUTS − 1,
+
+disjoint between splits and from the benchmark's seeds (< FETCH_SEED_BASE); the train split
+also uses the canonical layout (fetch seed 0) for a ``CANONICAL_SHARE`` of its samples. The
+obstacles are the fetch scene's for that gripper state (table, storage, and the stick unless
+held) plus the boxes; when holding, the robot carries the layout's stick (length 0.15–0.30 m,
+width 0.02–0.04 m). ``scene_seed`` is the fetch seed of the sample's layout.
+
 Shard arrays (n samples, P obstacles of at most V vertices, N robot nodes):
 
 ========== ================= ====================================================
@@ -21,13 +34,19 @@ sizes      (n, P) int32      vertex count of each polygon (0 = no polygon)
 d          (n,) float64      coal signed distance (m)
 grad       (n, dof) float64  coal ∂f/∂q
 scene_seed (n,) int64        seed of the sample's scene
+gripper    (n,) int8         ur5e only: index into GRIPPER_STATES (open, closed, holding)
+stick      (n, 2) float64    ur5e only: held stick (length, width) (m); 0 unless holding
 ========== ================= ====================================================
+
+For the fixed-robot environments ``gripper`` and ``stick`` are None and ``nodes`` has one N;
+for ``ur5e`` ``nodes`` is zero-padded to the largest robot graph.
 """
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from functools import lru_cache
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -36,13 +55,20 @@ from tqdm import tqdm
 
 from .distance import signed_distance_and_grad
 from .errors import InputError, UnknownNameError
-from .scene import ENV_ROBOT, Scene, make_scene
+from .robot import Robot, load_robot
+from .scene import ENV_ROBOT, Scene, clear_of_base, make_scene
+from .ur5e import GRIPPER_STATES, TABLE_V
 
 SHARD_SIZE = 2500
 RANDOM_ENVS = ("b", "d", "e")
 SPLITS = {"train": (0, 50_000), "test": (1, 5_000)}  # split -> (seed, paper's size)
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 FIELDS = ("q", "nodes", "obstacles", "sizes", "d", "grad", "scene_seed")
+ROBOT_FIELDS = ("gripper", "stick")  # per-sample robot variant (ur5e only)
+ENVS = (*ENV_ROBOT, "ur5e")
+UR5E_LAYOUTS = 300  # fetch layouts per split
+FETCH_SEED_BASE = 10_000  # first fetch seed of the dataset layouts (benchmarks use smaller)
+CANONICAL_SHARE = 0.1  # fraction of ur5e train samples on the canonical layout (fetch seed 0)
 
 
 @dataclass(frozen=True)
@@ -57,24 +83,51 @@ class Dataset:
     d: np.ndarray
     grad: np.ndarray
     scene_seed: np.ndarray
+    gripper: np.ndarray | None = None
+    stick: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.q)
 
     def subset(self, index: np.ndarray | slice) -> Dataset:
         """The samples at ``index`` (an index array or a slice)."""
-        return Dataset(self.env, *(getattr(self, f)[index] for f in FIELDS))
+        extra = (
+            None if getattr(self, f) is None else getattr(self, f)[index] for f in ROBOT_FIELDS
+        )
+        return Dataset(self.env, *(getattr(self, f)[index] for f in FIELDS), *extra)
+
+    def robot(self, i: int) -> Robot:
+        """The robot of sample i (the environment's, or the ur5e with the sample's gripper)."""
+        if self.gripper is None:
+            return env_robot(self.env)
+        return variant_robot(int(self.gripper[i]), *(float(x) for x in self.stick[i]))
+
+    def variants(self) -> dict[tuple[int, float, float], np.ndarray]:
+        """Sample indices per robot variant (gripper code, stick length, stick width).
+
+        Fixed-robot environments have one variant, ``(-1, 0.0, 0.0)``.
+        """
+        if self.gripper is None:
+            return {(-1, 0.0, 0.0): np.arange(len(self))}
+        keys = np.column_stack([self.gripper.astype(float), self.stick])
+        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        return {
+            (int(k[0]), float(k[1]), float(k[2])): np.flatnonzero(inverse == j)
+            for j, k in enumerate(uniq)
+        }
 
     def scene(self, i: int) -> Scene:
         """The scene of sample i (its robot and obstacle polygons)."""
         polys = [self.obstacles[i, p, :s] for p, s in enumerate(self.sizes[i]) if s > 0]
         polys = tuple(np.asarray(p, float) for p in polys)
-        return Scene(make_scene(self.env).robot, polys, name=self.env)
+        return Scene(self.robot(i), polys, name=self.env)
 
     def save(self, path: Path | str, compact: bool = False) -> None:
         """Write one ``.npz`` (atomic). ``compact`` drops ``nodes`` and stores float32 polygons."""
         path = Path(path)
         arrays = {f: getattr(self, f) for f in FIELDS}
+        arrays |= {f: getattr(self, f) for f in ROBOT_FIELDS if getattr(self, f) is not None}
         if compact:
             arrays["nodes"] = np.zeros((len(self), 0, 2), np.float32)
             arrays["obstacles"] = arrays["obstacles"].astype(np.float32)
@@ -96,8 +149,89 @@ def pad_polygons(polys: list[list[np.ndarray]]) -> tuple[np.ndarray, np.ndarray]
     return out, sizes
 
 
+def env_robot(env: str) -> Robot:
+    """The robot of an environment (``ur5e``: the UR5e with its gripper open)."""
+    return load_robot("ur5e", gripper="open") if env == "ur5e" else make_scene(env).robot
+
+
+def variant_robot(gripper: int, stick_length: float = 0.0, stick_width: float = 0.0) -> Robot:
+    """The UR5e with gripper state ``GRIPPER_STATES[gripper]`` (holding: the stick's size, m);
+    ``gripper = −1`` is not a variant (fixed-robot environments use :func:`env_robot`)."""
+    state = GRIPPER_STATES[gripper]
+    if state != "holding":
+        return load_robot("ur5e", gripper=state)
+    return load_robot("ur5e", gripper=state, stick_length=stick_length, stick_width=stick_width)
+
+
+@lru_cache(maxsize=2048)
+def _fetch_base(layout_seed: int, gripper: str) -> Scene:
+    return make_scene("fetch", seed=layout_seed, gripper=gripper)
+
+
+def random_boxes(rng: np.random.Generator, robot: Robot, k: int) -> list[np.ndarray]:
+    """k random rectangles around the storage, clear of the robot's base (CCW (4, 2), m).
+
+    Centre u ∈ [0.25, 1.4], v ∈ [TABLE_V, TABLE_V + 1], sides ∈ [0.04, 0.25], rotation
+    θ ∈ [0, π/2); drawn again while within ``robot.base_radius`` of joint 1.
+    """
+    boxes: list[np.ndarray] = []
+    while len(boxes) < k:
+        c = np.array([rng.uniform(0.25, 1.4), rng.uniform(TABLE_V, TABLE_V + 1.0)])
+        half = rng.uniform(0.02, 0.125, 2)
+        t = rng.uniform(0, np.pi / 2)
+        rot = np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
+        box = c + (np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * half) @ rot.T
+        if clear_of_base(box, robot):
+            boxes.append(box)
+    return boxes
+
+
+def ur5e_layout_seeds(seed: int) -> np.ndarray:
+    """Fetch seeds of the layout pool of the split with ``seed`` (see the module docstring)."""
+    return FETCH_SEED_BASE + seed * 10**6 + np.arange(UR5E_LAYOUTS, dtype=np.int64)
+
+
+def make_ur5e_shard(seed: int, start: int, n: int) -> Dataset:
+    """Samples ``start … start + n − 1`` of the ``ur5e`` split with ``seed``.
+
+    Per sample (rng seeded by (seed, start)): gripper state uniform over GRIPPER_STATES, a
+    layout from the split's pool (the canonical one with probability CANONICAL_SHARE when
+    seed = 0), 1–3 random boxes, q uniform within the limits; labels from coal.
+    """
+    rng = np.random.default_rng([seed, start, 7])
+    pool = ur5e_layout_seeds(seed)
+    gripper = rng.integers(0, len(GRIPPER_STATES), n).astype(np.int8)
+    layout = pool[rng.integers(0, len(pool), n)]
+    if seed == 0:
+        layout[rng.random(n) < CANONICAL_SHARE] = 0
+    q = np.empty((n, 3))
+    stick = np.zeros((n, 2))
+    d, grad = np.empty(n), np.empty((n, 3))
+    polys, nodes = [], []
+    for i in range(n):
+        base = _fetch_base(int(layout[i]), GRIPPER_STATES[gripper[i]])
+        robot = base.robot
+        if GRIPPER_STATES[gripper[i]] == "holding":
+            stick[i] = robot.info["stick_length"], robot.info["stick_width"]
+        obstacles = (*base.obstacles, *random_boxes(rng, robot, int(rng.integers(1, 4))))
+        scene = Scene(robot, obstacles, name="ur5e")
+        q[i] = robot.sample(1, seed=[seed, start + i])[0]
+        di, gi = signed_distance_and_grad(scene, q[i][None])
+        d[i], grad[i] = di[0], gi[0]
+        polys.append(list(obstacles))
+        nodes.append(robot.node_positions(q[i][None])[0])
+    obstacles_arr, sizes = pad_polygons(polys)
+    n_nodes = max(len(x) for x in nodes)
+    padded = np.zeros((n, n_nodes, 2), np.float32)
+    for i, x in enumerate(nodes):
+        padded[i, : len(x)] = x
+    return Dataset("ur5e", q, padded, obstacles_arr, sizes, d, grad, layout, gripper, stick)
+
+
 def make_shard(env: str, seed: int, start: int, n: int) -> Dataset:
     """Samples ``start … start + n − 1`` of the split of ``env`` with ``seed``."""
+    if env == "ur5e":
+        return make_ur5e_shard(seed, start, n)
     base = make_scene(env, seed=0)
     robot = base.robot
     q = robot.sample(n, seed=[seed, start])
@@ -136,7 +270,7 @@ def generate(env: str, n: int, seed: int, out_dir: Path | str, workers: int | No
     """Write an n-sample split of ``env`` as shards in ``out_dir``; finished shards are kept.
 
     Args:
-        env: environment name (``"a"`` … ``"e"``).
+        env: environment name (``"a"`` … ``"e"``, ``"ur5e"``).
         n: number of samples.
         seed: split seed (train 0, test 1 by convention, see ``SPLITS``).
         out_dir: directory of the shards (created).
@@ -145,8 +279,8 @@ def generate(env: str, n: int, seed: int, out_dir: Path | str, workers: int | No
     Returns:
         ``out_dir``.
     """
-    if env not in ENV_ROBOT:
-        raise UnknownNameError(f"env: unknown environment {env!r}; choose one of {list(ENV_ROBOT)}")
+    if env not in ENVS:
+        raise UnknownNameError(f"env: unknown environment {env!r}; choose one of {list(ENVS)}")
     if n < 1:
         raise InputError(f"n: expected a positive number of samples, got {n}")
     out_dir = Path(out_dir)
@@ -176,20 +310,28 @@ def load(path: Path | str, n: int | None = None) -> Dataset:
     total = 0
     for f in files:
         with np.load(f) as z:
-            parts.append({k: z[k] for k in ("env", *FIELDS)})
+            parts.append({k: z[k] for k in ("env", *FIELDS, *ROBOT_FIELDS) if k in z})
         total += len(parts[-1]["q"])
         if n is not None and total >= n:
             break
     n_poly = max(p["obstacles"].shape[1] for p in parts)
     n_vert = max(p["obstacles"].shape[2] for p in parts)
+    n_nodes = max(p["nodes"].shape[1] for p in parts)
     for p in parts:
         o, s = p["obstacles"], p["sizes"]
         p["obstacles"] = np.pad(
             o, ((0, 0), (0, n_poly - o.shape[1]), (0, n_vert - o.shape[2]), (0, 0))
         )
         p["sizes"] = np.pad(s, ((0, 0), (0, n_poly - s.shape[1])))
+        if "gripper" in p:
+            nd = p["nodes"]
+            p["nodes"] = np.pad(nd, ((0, 0), (0, n_nodes - nd.shape[1]), (0, 0)))
     arrays = [np.concatenate([p[f] for p in parts])[:n] for f in FIELDS]
-    return Dataset(str(parts[0]["env"]), *arrays)
+    extra = [
+        np.concatenate([p[f] for p in parts])[:n] if all(f in p for p in parts) else None
+        for f in ROBOT_FIELDS
+    ]
+    return Dataset(str(parts[0]["env"]), *arrays, *extra)
 
 
 def split_dir(env: str, split: str, root: Path | str = DATA_DIR) -> Path:

@@ -274,3 +274,36 @@ def collate(graphs: list[tuple[np.ndarray, np.ndarray, np.ndarray]], **kwargs) -
         k = len(x)
         nodes[i, :k], prev[i, :k], next[i, :k], mask[i, :k] = x, p, nx, True
     return GraphBatch.from_numpy(nodes, prev, next, mask, **kwargs)
+
+
+def variant_graphs(
+    groups: list[tuple[Robot, np.ndarray]], q: np.ndarray, max_edge: float | None = None
+) -> tuple[np.ndarray, np.ndarray, GraphBatch]:
+    """Robot graphs of samples whose robots differ (e.g. the UR5e's gripper states), padded.
+
+    Args:
+        groups: (robot, rows) pairs: the samples ``rows`` (index array) use ``robot``; every
+            sample belongs to exactly one group, all robots have the same dof.
+        q: (B, dof) joint angles (rad).
+        max_edge: densification length (m) or None.
+
+    Returns:
+        nodes (B, N, 2) (m), Jacobians (B, N, 2, dof) and the structure as a GraphBatch with
+        those nodes (float32), N the largest node count; padded slots have zero nodes and
+        Jacobians, ``mask = False`` and point to themselves.
+    """
+    q = np.asarray(q, dtype=float)
+    graphs = [(robot_graph(robot, max_edge), np.asarray(rows)) for robot, rows in groups]
+    b, n = len(q), max(g.n_nodes for g, _ in graphs)
+    if sorted(np.concatenate([rows for _, rows in graphs]).tolist()) != list(range(b)):
+        raise InputError("groups: every sample must belong to exactly one robot group")
+    nodes = np.zeros((b, n, 2))
+    jac = np.zeros((b, n, 2, q.shape[1]))
+    prev = np.broadcast_to(np.arange(n), (b, n)).copy()
+    next = prev.copy()
+    mask = np.zeros((b, n), bool)
+    for g, rows in graphs:
+        k = g.n_nodes
+        nodes[rows, :k], jac[rows, :k] = g.positions_and_jacobians(q[rows])
+        prev[rows, :k], next[rows, :k], mask[rows, :k] = g.prev, g.next, True
+    return nodes, jac, GraphBatch.from_numpy(nodes, prev, next, mask)

@@ -35,10 +35,9 @@ from safetensors.torch import load_file, save_file
 from scipy.stats import rankdata
 from tqdm import tqdm
 
-from .data import DATA_DIR, Dataset, load, split_dir
-from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph
+from .data import DATA_DIR, Dataset, env_robot, load, split_dir
+from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
-from .scene import make_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS_DIR = ROOT / "weights"
@@ -56,6 +55,8 @@ class Tensors:
         obstacles: obstacle graphs of all samples.
         d: (n,) coal signed distances.
         grad: (n, dof) coal ∂f/∂q.
+        robot: per-sample robot graph structure (``ur5e``: the robot varies per sample),
+            padded to N_r nodes; None when every sample has ``graph``'s structure.
     """
 
     graph: RobotGraph
@@ -65,19 +66,33 @@ class Tensors:
     obstacles: GraphBatch
     d: torch.Tensor
     grad: torch.Tensor
+    robot: GraphBatch | None = None
 
     def __len__(self) -> int:
         return len(self.q)
 
     def batch(self, rows: torch.Tensor, device: str) -> tuple[GraphBatch, GraphBatch]:
-        robot = self.graph.batch(self.nodes[rows], device=device)
+        if self.robot is None:
+            robot = self.graph.batch(self.nodes[rows], device=device)
+        else:
+            robot = self.robot.index(rows).to(device)
         return robot, self.obstacles.index(rows).to(device)
 
 
 def tensors(ds: Dataset, config: GraphDistNetConfig) -> Tensors:
-    """Robot nodes, Jacobians and obstacle graphs of a dataset (densified as configured)."""
-    graph = robot_graph(make_scene(ds.env).robot, config.max_edge)
-    nodes, jac = graph.positions_and_jacobians(ds.q)
+    """Robot nodes, Jacobians and obstacle graphs of a dataset (densified as configured).
+
+    Samples with different robots (``ds.variants()``) get their own graph structures, padded
+    to the largest (Jacobians of padded nodes are zero); ``graph`` is then the environment
+    robot's graph (its reach is the metrics' unit).
+    """
+    graph = robot_graph(env_robot(ds.env), config.max_edge)
+    if ds.gripper is None:
+        nodes, jac = graph.positions_and_jacobians(ds.q)
+        structure = None
+    else:
+        groups = [(ds.robot(int(rows[0])), rows) for rows in ds.variants().values()]
+        nodes, jac, structure = variant_graphs(groups, ds.q, config.max_edge)
     return Tensors(
         graph,
         ds.q,
@@ -86,6 +101,7 @@ def tensors(ds: Dataset, config: GraphDistNetConfig) -> Tensors:
         obstacle_graph(ds.obstacles, ds.sizes, config.max_edge),
         torch.as_tensor(ds.d, dtype=torch.float32),
         torch.as_tensor(ds.grad, dtype=torch.float32),
+        structure,
     )
 
 
@@ -268,7 +284,7 @@ def train(
     Returns:
         The card written beside the weights (config, data, training log, test metrics).
     """
-    robot = make_scene(env).robot
+    robot = env_robot(env)
     config = (config or GraphDistNetConfig.smooth()).with_(
         scale=round(robot.reach, 6), origin=tuple(float(v) for v in robot.chain.joint_origins[0])
     )
