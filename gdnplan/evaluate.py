@@ -368,9 +368,9 @@ class BatchedGraphDistNet:
         return predict_net(self.model.net, tensors(ds, self.model.net.config), grad=grad)
 
 
-def load_graphdistnet(env: str) -> DistanceModel | None:
-    """GraphDistNet from ``weights/<env>.safetensors`` when it exists, else None."""
-    path = WEIGHTS_DIR / f"{env}.safetensors"
+def load_graphdistnet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
+    """GraphDistNet from ``<weights_dir>/<env>.safetensors`` when it exists, else None."""
+    path = Path(weights_dir) / f"{env}.safetensors"
     if not path.exists():
         return None
     from .models import load_model
@@ -378,11 +378,11 @@ def load_graphdistnet(env: str) -> DistanceModel | None:
     return BatchedGraphDistNet(load_model(path))
 
 
-def load_clearancenet(env: str) -> DistanceModel | None:
-    """ClearanceNet from ``weights/clearancenet_<env>.safetensors`` when it exists, else None."""
+def load_clearancenet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
+    """ClearanceNet from ``<weights_dir>/clearancenet_<env>.safetensors``, None if missing."""
     from .models.clearancenet import load as load_cn
 
-    path = WEIGHTS_DIR / f"clearancenet_{env}.safetensors"
+    path = Path(weights_dir) / f"clearancenet_{env}.safetensors"
     return load_cn(path) if path.exists() else None
 
 
@@ -448,15 +448,23 @@ def diffco_rows(env: str, ds: Dataset, s: TableSettings) -> list[Result]:
     return rows
 
 
-def table1_env(env: str, s: TableSettings) -> tuple[list[Result], float | None]:
+def table1_env(
+    env: str, s: TableSettings, weights_dir: Path = WEIGHTS_DIR, used: dict | None = None
+) -> tuple[list[Result], float | None]:
     """All methods on one environment, and Welch's p of GraphDistNet vs ClearanceNet errors."""
     ds = test_set(env, s.n)
     (_, _), coal_s = timed(lambda: coal_predict(ds, grad=False))
     rows = [Result("coal", env, len(ds), coal_s, None, None, float("nan"), None, 0, None, ds.d)]
     rows += diffco_rows(env, ds, s)
     learned = {}
+    files = {
+        "ClearanceNet": f"clearancenet_{env}.safetensors",
+        "GraphDistNet": f"{env}.safetensors",
+    }
     for name, loader in (("ClearanceNet", load_clearancenet), ("GraphDistNet", load_graphdistnet)):
-        model = loader(env)
+        if used is not None and (Path(weights_dir) / files[name]).exists():
+            used[files[name]] = sha256_prefix(Path(weights_dir) / files[name])
+        model = loader(env, weights_dir)
         if model is not None:
             learned[name] = evaluate_model(model, env, s.n, s.n_grad, ds=ds)
             rows.append(replace(learned[name], method=name))
@@ -536,17 +544,22 @@ def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> st
     return "\n".join(lines) + "\n" + NOTES
 
 
-def table1(envs: tuple[str, ...] = ENVS, fast: bool = False, log=print):
-    """Run Table I; returns {env: (rows, p)}. ``fast`` uses :meth:`TableSettings.fast`."""
+def table1(
+    envs: tuple[str, ...] = ENVS, fast: bool = False, log=print, weights_dir: Path = WEIGHTS_DIR
+):
+    """Run Table I: ({env: (rows, p)}, missing weights, {weights file: sha256 prefix at load}).
+
+    ``fast`` uses :meth:`TableSettings.fast`.
+    """
     import torch
 
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # stable timings on a shared CPU; every network gets one thread
     s = TableSettings.fast() if fast else TableSettings()
-    out = {}
+    out, used = {}, {}
     try:
         for env in envs:
-            out[env] = table1_env(env, s)
+            out[env] = table1_env(env, s, weights_dir, used)
             log(f"env {env}: " + ", ".join(r.method for r in out[env][0]))
     finally:
         torch.set_num_threads(threads)
@@ -554,9 +567,9 @@ def table1(envs: tuple[str, ...] = ENVS, fast: bool = False, log=print):
         f"{name} {env}"
         for env in envs
         for name, path in (("ClearanceNet", f"clearancenet_{env}"), ("GraphDistNet", env))
-        if not (WEIGHTS_DIR / f"{path}.safetensors").exists()
+        if not (Path(weights_dir) / f"{path}.safetensors").exists()
     ]
-    return out, missing
+    return out, missing, used
 
 
 def detour_path(
@@ -625,13 +638,8 @@ def table1_figures(results: dict[str, tuple[list[Result], float | None]], out_di
     return paths
 
 
-def weights_fingerprint(envs: tuple[str, ...]) -> str:
-    """``name:sha256[:10]`` of every ClearanceNet / GraphDistNet weights file a table run uses."""
+def sha256_prefix(path: Path) -> str:
+    """First 10 hex digits of a file's SHA-256."""
     import hashlib
 
-    names = [f"clearancenet_{e}.safetensors" for e in envs] + [f"{e}.safetensors" for e in envs]
-    return ", ".join(
-        f"{n}:{hashlib.sha256((WEIGHTS_DIR / n).read_bytes()).hexdigest()[:10]}"
-        for n in names
-        if (WEIGHTS_DIR / n).exists()
-    )
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:10]
