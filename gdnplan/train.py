@@ -75,7 +75,8 @@ class Tensors:
         if self.robot is None:
             robot = self.graph.batch(self.nodes[rows], device=device)
         else:
-            robot = self.robot.index(rows).to(device)
+            r = self.robot  # not trimmed: rows keep N_r nodes, like the Jacobians
+            robot = GraphBatch(r.nodes[rows], r.prev[rows], r.next[rows], r.mask[rows]).to(device)
         return robot, self.obstacles.index(rows).to(device)
 
 
