@@ -337,3 +337,21 @@ def load(path: Path | str, n: int | None = None) -> Dataset:
 def split_dir(env: str, split: str, root: Path | str = DATA_DIR) -> Path:
     """``data/<env>/<split>``."""
     return Path(root) / env / split
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m gdnplan.data --env d [--split train] [--n 40000]``: write data/<env>/<split>."""
+    import argparse
+
+    p = argparse.ArgumentParser(description=main.__doc__)
+    p.add_argument("--env", required=True)
+    p.add_argument("--split", default="train", choices=sorted(SPLITS))
+    p.add_argument("--n", type=int, default=None, help="samples (default: the paper's size)")
+    p.add_argument("--workers", type=int, default=None)
+    a = p.parse_args(argv)
+    seed, size = SPLITS[a.split]
+    generate(a.env, a.n or size, seed, split_dir(a.env, a.split), a.workers)
+
+
+if __name__ == "__main__":
+    main()
