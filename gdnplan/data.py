@@ -22,7 +22,13 @@ disjoint between splits and from the benchmark's seeds (< FETCH_SEED_BASE); the 
 also uses the canonical layout (fetch seed 0) for a ``CANONICAL_SHARE`` of its samples. The
 obstacles are the fetch scene's for that gripper state (table, storage, and the stick unless
 held) plus the boxes; when holding, the robot carries the layout's stick (length 0.15–0.30 m,
-width 0.02–0.04 m). ``scene_seed`` is the fetch seed of the sample's layout.
+width 0.02–0.04 m). ``scene_seed`` is the fetch seed of the sample's layout. With
+``near`` > 0, that fraction of the samples is concentrated near the task's contacts:
+
+    q = clip(q_ref + ε, limits),  ε ~ N(0, NEAR_SIGMA² I),
+
+q_ref drawn from the layout's configurations of that gripper state (open/closed: q_home,
+q_pregrasp, q_grasp; holding: q_lift, q_out), where uniform samples rarely fall.
 
 Shard arrays (n samples, P obstacles of at most V vertices, N robot nodes):
 
@@ -69,6 +75,12 @@ ENVS = (*ENV_ROBOT, "ur5e")
 UR5E_LAYOUTS = 300  # fetch layouts per split
 FETCH_SEED_BASE = 10_000  # first fetch seed of the dataset layouts (benchmarks use smaller)
 CANONICAL_SHARE = 0.1  # fraction of ur5e train samples on the canonical layout (fetch seed 0)
+NEAR_SIGMA = 0.2  # rad: spread of the near-contact ur5e samples around the task configurations
+NEAR_REFS = {  # gripper state -> fetch configurations the near-contact samples spread around
+    "open": ("q_home", "q_pregrasp", "q_grasp"),
+    "closed": ("q_home", "q_pregrasp", "q_grasp"),
+    "holding": ("q_lift", "q_out"),
+}
 
 
 @dataclass(frozen=True)
@@ -191,19 +203,21 @@ def ur5e_layout_seeds(seed: int) -> np.ndarray:
     return FETCH_SEED_BASE + seed * 10**6 + np.arange(UR5E_LAYOUTS, dtype=np.int64)
 
 
-def make_ur5e_shard(seed: int, start: int, n: int) -> Dataset:
+def make_ur5e_shard(seed: int, start: int, n: int, near: float = 0.0) -> Dataset:
     """Samples ``start … start + n − 1`` of the ``ur5e`` split with ``seed``.
 
     Per sample (rng seeded by (seed, start)): gripper state uniform over GRIPPER_STATES, a
-    layout from the split's pool (the canonical one with probability CANONICAL_SHARE when
-    seed = 0), 1–3 random boxes, q uniform within the limits; labels from coal.
+    layout from the split's pool (the canonical one with probability CANONICAL_SHARE except in
+    the test split), 1–3 random boxes, q uniform within the limits or, with probability
+    ``near``, near a task configuration (module docstring); labels from coal.
     """
     rng = np.random.default_rng([seed, start, 7])
     pool = ur5e_layout_seeds(seed)
     gripper = rng.integers(0, len(GRIPPER_STATES), n).astype(np.int8)
     layout = pool[rng.integers(0, len(pool), n)]
-    if seed == 0:
+    if seed != SPLITS["test"][0]:
         layout[rng.random(n) < CANONICAL_SHARE] = 0
+    is_near = rng.random(n) < near if near > 0 else np.zeros(n, bool)  # uniform: rng as before
     q = np.empty((n, 3))
     stick = np.zeros((n, 2))
     d, grad = np.empty(n), np.empty((n, 3))
@@ -216,6 +230,9 @@ def make_ur5e_shard(seed: int, start: int, n: int) -> Dataset:
         obstacles = (*base.obstacles, *random_boxes(rng, robot, int(rng.integers(1, 4))))
         scene = Scene(robot, obstacles, name="ur5e")
         q[i] = robot.sample(1, seed=[seed, start + i])[0]
+        if is_near[i]:
+            ref = base.info[str(rng.choice(NEAR_REFS[GRIPPER_STATES[gripper[i]]]))]
+            q[i] = np.clip(ref + rng.normal(0.0, NEAR_SIGMA, 3), robot.lower, robot.upper)
         di, gi = signed_distance_and_grad(scene, q[i][None])
         d[i], grad[i] = di[0], gi[0]
         polys.append(list(obstacles))
@@ -228,10 +245,11 @@ def make_ur5e_shard(seed: int, start: int, n: int) -> Dataset:
     return Dataset("ur5e", q, padded, obstacles_arr, sizes, d, grad, layout, gripper, stick)
 
 
-def make_shard(env: str, seed: int, start: int, n: int) -> Dataset:
-    """Samples ``start … start + n − 1`` of the split of ``env`` with ``seed``."""
+def make_shard(env: str, seed: int, start: int, n: int, near: float = 0.0) -> Dataset:
+    """Samples ``start … start + n − 1`` of the split of ``env`` with ``seed`` (``near``:
+    fraction of near-contact samples, ``ur5e`` only)."""
     if env == "ur5e":
-        return make_ur5e_shard(seed, start, n)
+        return make_ur5e_shard(seed, start, n, near)
     base = make_scene(env, seed=0)
     robot = base.robot
     q = robot.sample(n, seed=[seed, start])
@@ -251,9 +269,9 @@ def make_shard(env: str, seed: int, start: int, n: int) -> Dataset:
     return Dataset(env, q, nodes, obstacles, sizes, d, grad, scene_seed)
 
 
-def _write_shard(job: tuple[str, int, int, int, str]) -> int:
-    env, seed, start, n, path = job
-    make_shard(env, seed, start, n).save(path)
+def _write_shard(job: tuple[str, int, int, int, str, float]) -> int:
+    env, seed, start, n, path, near = job
+    make_shard(env, seed, start, n, near).save(path)
     return n
 
 
@@ -266,7 +284,14 @@ def shard_paths(out_dir: Path | str, n: int) -> list[tuple[int, int, Path]]:
     ]
 
 
-def generate(env: str, n: int, seed: int, out_dir: Path | str, workers: int | None = None) -> Path:
+def generate(
+    env: str,
+    n: int,
+    seed: int,
+    out_dir: Path | str,
+    workers: int | None = None,
+    near: float = 0.0,
+) -> Path:
     """Write an n-sample split of ``env`` as shards in ``out_dir``; finished shards are kept.
 
     Args:
@@ -275,6 +300,7 @@ def generate(env: str, n: int, seed: int, out_dir: Path | str, workers: int | No
         seed: split seed (train 0, test 1 by convention, see ``SPLITS``).
         out_dir: directory of the shards (created).
         workers: processes (default: all cores).
+        near: fraction of near-contact samples (``ur5e`` only, see the module docstring).
 
     Returns:
         ``out_dir``.
@@ -285,7 +311,11 @@ def generate(env: str, n: int, seed: int, out_dir: Path | str, workers: int | No
         raise InputError(f"n: expected a positive number of samples, got {n}")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    jobs = [(env, seed, s, k, str(p)) for s, k, p in shard_paths(out_dir, n) if not p.exists()]
+    if near and env != "ur5e":
+        raise InputError(f"near: near-contact sampling is for env 'ur5e' only, not {env!r}")
+    jobs = [
+        (env, seed, s, k, str(p), near) for s, k, p in shard_paths(out_dir, n) if not p.exists()
+    ]
     done = n - sum(j[3] for j in jobs)
     workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
     with tqdm(total=n, initial=done, desc=f"generate {env} → {out_dir}", unit="sample") as bar:

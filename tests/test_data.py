@@ -97,3 +97,16 @@ def test_ur5e_shards_roundtrip_with_their_robot_variants(tmp_path):
     sub = back.subset(np.array([4, 1]))
     np.testing.assert_array_equal(sub.gripper, ds.gripper[[4, 1]])
     assert sum(len(rows) for rows in back.variants().values()) == 6
+
+
+def test_ur5e_near_contact_samples_spread_around_the_task_configurations():
+    ds = data.make_shard("ur5e", seed=2, start=0, n=6, near=1.0)
+    for i in range(len(ds)):
+        scene = ds.scene(i)
+        d, _ = gp.signed_distance_and_grad(scene, ds.q[i])
+        assert ds.d[i] == pytest.approx(d[0], abs=1e-9)
+        fetch = gp.make_scene("fetch", seed=int(ds.scene_seed[i]))
+        refs = [fetch.info[k] for k in ("q_home", "q_pregrasp", "q_grasp", "q_lift", "q_out")]
+        assert min(np.abs(ds.q[i] - r).max() for r in refs) < 6 * data.NEAR_SIGMA
+    with pytest.raises(gp.InputError):
+        data.generate("d", 10, 0, "unused", near=0.5)
