@@ -43,6 +43,7 @@ from .rrt import seed_path
 from .scene import Scene, scene_from_config
 
 WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
+WEIGHTS_FOR_SCENE = {"fetch": "ur5e"}  # scene name -> shipped weights name, where they differ
 TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options"}
 INITIAL_GUESSES = ("auto", "straight", "rrt")
 SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
@@ -306,6 +307,8 @@ class TrajoptOptions:
         obj_change_tol: Ipopt also stops ("acceptable") once the relative change of the path
             cost stays below this for 3 iterations at a feasible point (constraint violation
             ≤ 1e-5): the certified check, not the KKT residual, judges the result.
+        learned_margin: extra constraint margin (m) for learned models in the first solve;
+            later rounds add the overestimate coal finds (see ``_solve_refined``).
         rrt_clearance: extra clearance (m) above the margin demanded of seed paths (at most
             half the start's and goal's own clearance above the margin).
         rrt_time: time limit of one RRT-Connect run (s).
@@ -326,6 +329,7 @@ class TrajoptOptions:
     tol: float = 1e-3
     obj_change_tol: float = 1e-4
     rrt_clearance: float = 0.02
+    learned_margin: float = 0.0
     rrt_time: float = 5.0
     rrt_step: float = 2.0
     link_cap: float = 0.3
@@ -383,7 +387,8 @@ def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | P
         return CoalModel()
     if collision != "graphdistnet":
         raise InputError(f"collision: unknown {collision!r}; choose 'coal' or 'graphdistnet'")
-    path = Path(weights) if weights is not None else WEIGHTS_DIR / f"{scene.name}.safetensors"
+    default = WEIGHTS_DIR / f"{WEIGHTS_FOR_SCENE.get(scene.name, scene.name)}.safetensors"
+    path = Path(weights) if weights is not None else default
     if not path.exists():
         raise InputError(
             f"weights: {path} does not exist; train GraphDistNet for environment "
@@ -526,12 +531,20 @@ def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, 
 
 
 def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: _Run):
-    """Solve, certify, refine uncertified segments, re-solve: (q, last stats, certified)."""
+    """Solve, certify, refine, re-solve: (q, last stats, certified).
+
+    Each round that the coal certificate rejects doubles the check points of the rejected
+    segments and, for a learned model, raises the constraint margin by the model's observed
+    overestimate there (:func:`model_overestimate`): the learned constraint then keeps the
+    path away from the contact coal found, whatever the model's error.
+    """
     splits = np.full(problem.waypoints - 1, opts.interpolated + 1)
     per_link = supports_per_link(model) if opts.per_link is None else opts.per_link
+    learned = not isinstance(model, CoalModel)
+    margin = problem.margin + (opts.learned_margin if learned else 0.0)
     q = guess
     for _ in range(1 + (opts.refine_rounds if opts.ccd else 0)):
-        nlp = _Transcription(problem, model, goal, replace(opts, per_link=per_link), splits)
+        nlp = _Transcription(problem, model, goal, replace(opts, per_link=per_link), splits, margin)
         q, stats = nlp.solve(q)
         run.iterations += stats.get("iter_count", 0)
         run.model_calls += nlp.callback.model_calls
@@ -543,15 +556,38 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         run.verified = (cert.ok, cert.min_distance)
         if cert.ok:
             return q, stats, True
-        splits[list(cert.bad_segments)] *= 2
+        bad = list(cert.bad_segments)
+        splits[bad] *= 2
+        if learned:
+            margin += model_overestimate(problem.scene, model, q, bad, problem.margin)
     return q, stats, False
+
+
+def model_overestimate(
+    scene: Scene, model: DistanceModel, q: np.ndarray, segments: list[int], margin: float
+) -> float:
+    """How much a learned model overestimates the distance where coal finds the path too close.
+
+    Samples the given waypoint segments of q (T, dof) densely (20 points each) and returns
+    max(d̂ − d_coal) over the points with d_coal < margin, at least 5 mm (m).
+    """
+    t = np.linspace(0.0, 1.0, 21)[:, None]
+    points = np.concatenate([q[i] + t * (q[i + 1] - q[i]) for i in segments])
+    d_coal = signed_distance(scene, points)
+    close = d_coal < margin
+    if not close.any():
+        return 0.005
+    excess = model.distance(scene, points[close]) - d_coal[close]
+    return max(float(np.max(excess)), 0.005)
 
 
 class _Transcription:
     """The NLP of the module docstring for one set of check points (segment t split in
     ``splits[t]`` pieces); rebuilt when the certificate refines them."""
 
-    def __init__(self, problem: Problem, model: DistanceModel, goal, opts, splits: np.ndarray):
+    def __init__(
+        self, problem: Problem, model: DistanceModel, goal, opts, splits: np.ndarray, margin: float
+    ):
         robot = problem.scene.robot
         T, n = problem.waypoints, robot.dof
         self.problem, self.goal, self.T = problem, goal, T
@@ -570,9 +606,7 @@ class _Transcription:
         steps = Q[1:, :] - Q[:-1, :]  # (T−1, n)
         g = casadi.vertcat(d, casadi.reshape(steps, (T - 1) * n, 1))
         n_steps = (T - 1) * n
-        self.lbg = np.concatenate(
-            [np.full(K * rows, problem.margin), np.full(n_steps, -problem.max_step)]
-        )
+        self.lbg = np.concatenate([np.full(K * rows, margin), np.full(n_steps, -problem.max_step)])
         self.ubg = np.concatenate([np.full(K * rows, np.inf), np.full(n_steps, problem.max_step)])
         self.lbx = np.tile(problem.lower, T - 2)
         self.ubx = np.tile(problem.upper, T - 2)
@@ -587,6 +621,7 @@ class _Transcription:
             "acceptable_obj_change_tol": opts.obj_change_tol,
             "acceptable_constr_viol_tol": 1e-5,
             "mu_strategy": "adaptive",
+            "sb": "yes",  # no banner: stdout stays clean for --json
         }
         self.solver = casadi.nlpsol(
             "trajopt",
