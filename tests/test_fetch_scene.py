@@ -109,6 +109,9 @@ def test_problem_files_are_valid(name):
     q = np.array([cfg["start"]["q"], cfg["goal"]["q"]])
     assert scene.robot.within_limits(q).all()
     assert (gp.signed_distance(scene, q) > cfg["options"]["margin"]).all()
+    gp.Problem.from_toml(PROBLEMS / f"{name}.toml")  # raises on provably infeasible problems
+    line = q[0] + np.linspace(0, 1, 101)[:, None] * (q[1] - q[0])
+    assert gp.signed_distance(scene, line).min() < 0  # the straight path collides: a real task
     if name.startswith("fetch"):
         keys = ("q_home", "q_grasp") if name == "fetch_reach" else ("q_lift", "q_out")
         np.testing.assert_allclose(q, [scene.info[k] for k in keys], atol=1e-6)
