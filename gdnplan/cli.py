@@ -254,6 +254,79 @@ def fetch_command(
         raise typer.Exit(1)
 
 
+@app.command("generate")
+def generate_command(
+    env: str = typer.Option(..., help="Environment: a-e or ur5e."),
+    split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
+    n: int = typer.Option(None, help="Samples (default: the paper's 50 000 / 5 000)."),
+    seed: int = typer.Option(None, help="Override the split's seed."),
+    near: float = typer.Option(0.0, help="Fraction of samples drawn near contact (ur5e)."),
+    workers: int = typer.Option(None, help="Worker processes (default: all cores)."),
+    data: Path = typer.Option(None, help="Data root (default data/): <data>/<env>/<split>."),
+) -> None:
+    """Write a dataset of graphs and coal labels in resumable shards (finished shards are kept)."""
+    from .data import DATA_DIR, SPLITS, generate, split_dir
+
+    if split not in SPLITS:
+        raise InputError(f"--split: expected one of {sorted(SPLITS)}, got {split!r}")
+    split_seed, size = SPLITS[split]
+    target = split_dir(env, split, data or DATA_DIR)
+    generate(env, n or size, split_seed if seed is None else seed, target, workers, near)
+    typer.echo(f"wrote {target}")
+
+
+@app.command("train")
+def train_command(
+    env: str = typer.Option(..., help="Environment: a-e or ur5e (its data must exist)."),
+    model: str = typer.Option("graphdistnet", help="graphdistnet or clearancenet."),
+    preset: str = typer.Option("smooth", help="GraphDistNet: smooth (planner) or faithful."),
+    name: str = typer.Option(None, help="Run name, runs/<env>-<name> (default: the preset)."),
+    set_: list[str] = typer.Option([], "--set", help="Config override key=json_value."),
+    n_train: int = typer.Option(None, help="Use only the first n training samples."),
+    batch: int = typer.Option(256, help="Batch size."),
+    lr: float = typer.Option(1e-3, help="Adam learning rate."),
+    epochs: int = typer.Option(200, help="Epoch cap."),
+    patience: int = typer.Option(10, help="Early stopping: epochs without improvement."),
+    time_budget: float = typer.Option(None, help="Seconds of training."),
+    seed: int = typer.Option(0, help="Random seed."),
+    device: str = typer.Option("cpu", help="cpu or cuda."),
+    threads: int = typer.Option(1, help="torch threads."),
+    data: Path = typer.Option(None, help="Data root (default: data/)."),
+    out: Path = typer.Option(None, help="Weights path (default: weights/<env>.safetensors)."),
+    run_dir: Path = typer.Option(None, help="Checkpoints, loss curve (default runs/<env>-<name>)."),
+    compile: bool = typer.Option(False, "--compile", help="torch.compile the training step."),
+) -> None:
+    """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
+    if model == "clearancenet":
+        from .models.clearancenet import train_and_save
+
+        card = train_and_save(env, time_budget or 120.0, patience, out)
+        typer.echo(json.dumps({"env": env, **card["test"]}, indent=2))
+        return
+    if model != "graphdistnet":
+        raise InputError(f"--model: expected graphdistnet or clearancenet, got {model!r}")
+    import torch
+
+    from .data import DATA_DIR
+    from .models.graphdistnet import GraphDistNetConfig
+    from .train import PRESETS, train
+
+    if preset not in PRESETS:
+        raise InputError(f"--preset: expected one of {sorted(PRESETS)}, got {preset!r}")
+    try:
+        overrides = {k: json.loads(v) for k, v in (s.split("=", 1) for s in set_)}
+    except ValueError as e:
+        raise InputError(f"--set: expected key=json_value, got {set_}") from e
+    config = GraphDistNetConfig.from_dict(PRESETS[preset]().to_dict() | overrides)
+    torch.set_num_threads(threads)
+    card = train(
+        env, config, name or preset, n_train, batch, lr, epochs, patience, time_budget, seed,
+        device, data_root=data or DATA_DIR, out=out, run_dir=run_dir,
+        compile=compile,
+    )
+    typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
+
+
 @app.command("field")
 def field_command(
     env: str = typer.Option("a", help="A 2-DoF environment (a or b)."),
@@ -268,13 +341,19 @@ def field_command(
     typer.echo(f"wrote {out}")
 
 
-def main() -> None:
-    """Console entry point: run the app, turning GdnplanError into one line and exit code 2."""
+def run(args: list[str] | None = None) -> None:
+    """Run the app on ``args`` (default: the command line), turning GdnplanError into one line
+    and exit code 2."""
     try:
-        app()
+        app(args=args, prog_name="gdnplan")
     except GdnplanError as e:
         typer.echo(f"error: {e}", err=True)
         sys.exit(2)
+
+
+def main() -> None:
+    """Console entry point."""
+    run()
 
 
 if __name__ == "__main__":

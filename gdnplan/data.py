@@ -370,17 +370,12 @@ def split_dir(env: str, split: str, root: Path | str = DATA_DIR) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m gdnplan.data --env d [--split train] [--n 40000]``: write data/<env>/<split>."""
-    import argparse
+    """``python -m gdnplan.data …``: the same as ``gdnplan generate …``."""
+    import sys
 
-    p = argparse.ArgumentParser(description=main.__doc__)
-    p.add_argument("--env", required=True)
-    p.add_argument("--split", default="train", choices=sorted(SPLITS))
-    p.add_argument("--n", type=int, default=None, help="samples (default: the paper's size)")
-    p.add_argument("--workers", type=int, default=None)
-    a = p.parse_args(argv)
-    seed, size = SPLITS[a.split]
-    generate(a.env, a.n or size, seed, split_dir(a.env, a.split), a.workers)
+    from .cli import run
+
+    run(["generate", *(sys.argv[1:] if argv is None else argv)])
 
 
 if __name__ == "__main__":

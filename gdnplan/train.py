@@ -20,7 +20,6 @@ Metrics (:func:`evaluate`, paper Table I), against coal labels on a held-out spl
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -432,43 +431,12 @@ PRESETS = {"faithful": GraphDistNetConfig.faithful, "smooth": GraphDistNetConfig
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m gdnplan.train --env d [--preset smooth] [--set key=value ...]``."""
-    p = argparse.ArgumentParser(description=main.__doc__)
-    p.add_argument("--env", required=True)
-    p.add_argument("--preset", default="smooth", choices=sorted(PRESETS))
-    p.add_argument("--name", default=None, help="run name (default: the preset)")
-    p.add_argument("--set", nargs="*", default=[], help="config overrides key=json_value")
-    p.add_argument("--n-train", type=int, default=None)
-    p.add_argument("--batch", type=int, default=256)
-    p.add_argument("--lr", type=float, default=1e-3)
-    p.add_argument("--epochs", type=int, default=200)
-    p.add_argument("--patience", type=int, default=10)
-    p.add_argument("--time-budget", type=float, default=None, help="seconds of training")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--device", default="cpu")
-    p.add_argument("--threads", type=int, default=1)
-    p.add_argument("--out", default=None)
-    p.add_argument("--compile", action="store_true", help="torch.compile the training step")
-    a = p.parse_args(argv)
-    torch.set_num_threads(a.threads)
-    overrides = {k: json.loads(v) for k, v in (s.split("=", 1) for s in a.set)}
-    config = GraphDistNetConfig.from_dict(PRESETS[a.preset]().to_dict() | overrides)
-    card = train(
-        a.env,
-        config,
-        a.name or a.preset,
-        a.n_train,
-        a.batch,
-        a.lr,
-        a.epochs,
-        a.patience,
-        a.time_budget,
-        a.seed,
-        a.device,
-        out=a.out,
-        compile=a.compile,
-    )
-    print(json.dumps({"env": a.env, "name": card["name"], **card["test"]}, indent=2))
+    """``python -m gdnplan.train …``: the same as ``gdnplan train …``."""
+    import sys
+
+    from .cli import run
+
+    run(["train", *(sys.argv[1:] if argv is None else argv)])
 
 
 if __name__ == "__main__":

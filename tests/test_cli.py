@@ -1,9 +1,12 @@
+import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+import gdnplan as gp
 from gdnplan.cli import app
 
 runner = CliRunner()
@@ -60,3 +63,40 @@ def test_malformed_toml_names_the_file(tmp_path):
         text=True,
     )
     assert proc.returncode == 2 and "malformed TOML" in proc.stderr
+
+
+def test_generate_then_train_writes_loadable_weights(tmp_path):
+    """The data → training path as a user runs it: two CLI commands, then gp.load_model."""
+    data = tmp_path / "data"
+    for split, n in (("train", 80), ("test", 40)):
+        result = runner.invoke(
+            app, ["generate", "--env", "a", "--split", split, "--n", str(n), "--data", str(data),
+                  "--workers", "1"],
+        )
+        assert result.exit_code == 0, result.output
+    out = tmp_path / "a.safetensors"
+    result = runner.invoke(
+        app, ["train", "--env", "a", "--data", str(data), "--out", str(out), "--epochs", "1",
+              "--set", "layers=1", "--run-dir", str(tmp_path / "run")],
+    )
+    assert result.exit_code == 0, result.output
+    card = json.loads(out.with_suffix(".json").read_text())
+    assert card["config"]["layers"] == 1 and card["test"]["n"] == 40
+    model = gp.load_model(out)
+    scene = gp.make_scene("a")
+    d = model.distance(scene, scene.robot.sample(5, seed=0))
+    assert d.shape == (5,) and np.isfinite(d).all()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["train", "--env", "a", "--model", "svm"], "--model: expected"),
+        (["train", "--env", "a", "--preset", "fast"], "--preset: expected"),
+        (["generate", "--env", "a", "--split", "val"], "--split: expected"),
+    ],
+)
+def test_train_and_generate_reject_bad_options(args, message):
+    result = runner.invoke(app, args)
+    assert result.exit_code != 0
+    assert message in str(result.exception) or message in result.output
