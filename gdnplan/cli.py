@@ -81,6 +81,7 @@ def plan_command(
     seed: int = typer.Option(0, help="Seed of the sampling-based initial guesses."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
+    view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
 ) -> None:
     """Plan a collision-free trajectory; success is certified by a dense coal check.
 
@@ -88,6 +89,10 @@ def plan_command(
     """
     from .trajopt import Problem, plan
 
+    if view3d:  # fail before planning, not after
+        from .viz3d import require_meshcat
+
+        require_meshcat()
     problem = Problem.from_toml(problem_file)
     result = plan(problem, collision=collision, solver=solver, weights=weights, seed=seed)
     if json_output:
@@ -107,6 +112,10 @@ def plan_command(
         )
         if not json_output:
             typer.echo(f"wrote {animate}")
+    if view3d:
+        from .viz3d import view_plan
+
+        view_plan([(problem.scene, result.q)])
     if not result.success:
         raise typer.Exit(1)
 
@@ -219,6 +228,7 @@ def fetch_command(
     weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/ur5e)."),
     animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
 ) -> None:
     """The UR5e fetch: approach, reach in, grasp, lift, bring the stick out, retreat.
 
@@ -226,6 +236,10 @@ def fetch_command(
     """
     from .fetch import run_fetch
 
+    if view3d:  # fail before planning, not after
+        from .viz3d import require_meshcat
+
+        require_meshcat()
     stages = run_fetch(seed, collision=collision, weights=weights)
     ok = all(s.success for s in stages)
     if json_output:
@@ -250,6 +264,10 @@ def fetch_command(
         animate_paths([(s.scene, s.q) for s in stages], animate, title=title)
         if not json_output:
             typer.echo(f"wrote {animate}")
+    if view3d:
+        from .viz3d import view_plan
+
+        view_plan([(s.scene, s.q) for s in stages])
     if not ok:
         raise typer.Exit(1)
 
