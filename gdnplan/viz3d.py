@@ -332,6 +332,7 @@ def send_plan(
         with animation.at_frame(viewer, i) as node:
             _place(node, paths, frame)
     _place(viewer, paths, frames[0])
+    _aim_camera(viewer, robot, frames[0])
     viewer.set_animation(animation, play=True)
     return len(frames)
 
@@ -384,6 +385,33 @@ def _load_objects(viewer, frames: list[Frame]) -> None:
             material = mg.MeshLambertMaterial(color=prism.color)
             viewer[f"scene/{name}"].set_object(mg.TriangularMeshGeometry(vertices, faces), material)
             sent.add(name)
+
+
+def camera_placement(robot: Robot, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+    """Orbit target (3,) and camera position (3,) (world, m) that face the robot's plane.
+
+    The target is the centre of the frame's bounding box (robot geometry origins and object
+    vertices); the camera stands 1.2 box diagonals away along the plane normal, raised by a
+    third of that along v and shifted by a fifth along u.
+    """
+    points = np.vstack(
+        [np.array([pose[:3, 3] for pose in frame.robot.values()])]
+        + [prism.world_vertices() for prism in frame.objects.values()]
+    )
+    low, high = points.min(0), points.max(0)
+    target, distance = (low + high) / 2, 1.2 * float(np.linalg.norm(high - low))
+    axes = robot.plane.axes
+    return target, target + distance * (robot.plane.normal + axes[1] / 3 + axes[0] / 5)
+
+
+def _aim_camera(viewer, robot: Robot, frame: Frame) -> None:
+    """Point meshcat's default camera (orbiting ``/Cameras/default``, y-up below it)."""
+    target, position = camera_placement(robot, frame)
+    pose = np.eye(4)
+    pose[:3, 3] = target
+    viewer["/Cameras/default"].set_transform(pose)
+    x, y, z = position - target
+    viewer["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
 
 
 def _place(node, paths: dict[str, str], frame: Frame) -> None:

@@ -192,6 +192,9 @@ def test_send_plan_loads_robot_objects_and_animation(fetch):
     assert len(clips) == len(geometry) + len(scene_objects(open_))
     keys = clips["/meshcat/scene/stick"]["tracks"][0]["keys"]
     assert [k["time"] for k in keys] == [0, 1, 2]
+    (camera,) = [c for c in window.commands if c["path"].endswith("rotated/<object>")]
+    assert camera["path"] == "/Cameras/default/rotated/<object>"
+    assert camera["value"][2] > 1.0  # y-up camera frame: in front of the x–z plane (world −y)
 
 
 @pytest.mark.slow
