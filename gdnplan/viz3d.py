@@ -200,12 +200,16 @@ def full_robot(robot: Robot) -> FullRobot:
 
     Each locked joint's value is recovered from the reduced model (``robot.model``), where
     Pinocchio keeps the joint as a fixed frame of the same name placed at its locked value.
+    ``package://`` mesh paths resolve against the URDF's parent folders.
     """
     urdf = Path(robot.info.get("urdf", ""))
     if not urdf.is_file():
         raise InputError(f"3-D view: robot {robot.name!r} has no URDF file ({urdf})")
     model = pin.buildModelFromUrdf(str(urdf))
-    geometry = pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION)
+    packages = [str(p) for p in urdf.resolve().parents]  # package:// meshes, as ROS lays them
+    geometry = pin.buildGeomFromUrdf(
+        model, str(urdf), pin.GeometryType.COLLISION, package_dirs=packages
+    )
     reduced = robot.model
     rdata = reduced.createData()
     pin.framesForwardKinematics(reduced, rdata, np.zeros(robot.dof))

@@ -89,7 +89,7 @@ def test_full_robot_reads_back_the_locked_joints(gripper):
     assert full.model.nq == 8 and full.planning_index.tolist() == [1, 2, 3]
 
 
-@pytest.mark.parametrize("name", ["ur5e", "planar7"])
+@pytest.mark.parametrize("name", ["ur5e", "ur5", "planar7"])
 def test_full_robot_places_the_tool_where_the_planar_model_does(name, fetch):
     robot = fetch["open"].robot if name == "ur5e" else load_robot(name)
     full = full_robot(robot)
