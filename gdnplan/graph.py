@@ -216,14 +216,64 @@ class RobotGraph:
     def n_nodes(self) -> int:
         return len(self.nodes0)
 
+    def kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Node positions (B, N, 2) and joint positions (B, dof, 2) at q (B, dof) (m).
+
+        Body b (after the first b joints) moves rigidly, x ↦ R(θ_b) x + t_b, with
+        θ_b = Σ_{j<b} s_j q_j, t_0 = 0 and, joint j sitting on body j,
+
+            o_j(q) = R(θ_j) o_j⁰ + t_j,   t_{j+1} = o_j(q) − R(θ_{j+1}) o_j⁰,
+
+        so a node on body b is at p = R(θ_b) p⁰ + t_b: O(B (dof + N)) work, no per-joint copies.
+        """
+        q = self.robot.check_q(q)
+        chain = self.robot.chain
+        theta = np.zeros((len(q), chain.dof + 1))
+        np.cumsum(q * chain.joint_signs, 1, out=theta[:, 1:])
+        cos, sin = np.cos(theta), np.sin(theta)
+        t = np.zeros((len(q), chain.dof + 1, 2))
+        joints = np.empty((len(q), chain.dof, 2))
+        for j, (ox, oy) in enumerate(chain.joint_origins):
+            joints[:, j] = _rotate(cos[:, j], sin[:, j], ox, oy) + t[:, j]
+            t[:, j + 1] = joints[:, j] - _rotate(cos[:, j + 1], sin[:, j + 1], ox, oy)
+        c, s = cos[:, self.body], sin[:, self.body]  # (B, N)
+        x, y = self.nodes0[:, 0], self.nodes0[:, 1]
+        nodes = np.stack([c * x - s * y, s * x + c * y], -1) + t[:, self.body]
+        return nodes, joints
+
     def positions(self, q: np.ndarray) -> np.ndarray:
         """(B, N, 2) node positions at q (B, dof) (m)."""
-        return self.robot.chain.transform(self.nodes0, self.body, self.robot.check_q(q))
+        return self.kinematics(q)[0]
+
+    def pullback(self, nodes: np.ndarray, joints: np.ndarray, grad: np.ndarray) -> np.ndarray:
+        """(B, dof) Σ_n (∂p_n/∂q)ᵀ g_n: a gradient g (B, N, 2) on the nodes chained to q.
+
+        With ∂p_n/∂q_j = s_j ẑ × (p_n − o_j) for nodes downstream of joint j (M_nj = 1),
+        g_n · (ẑ × r) = r × g_n, so (joint torques of the node forces g_n)
+
+            ∂/∂q_j = s_j (Σ_n M_nj p_n × g_n − o_j × Σ_n M_nj g_n),
+
+        two (N × dof) products instead of the (B, N, 2, dof) Jacobians.
+
+        Args:
+            nodes: (B, N, 2) and joints: (B, dof, 2) from :meth:`kinematics` (m).
+            grad: (B, N, 2) gradient with respect to the node positions.
+        """
+        m = self.downstream
+        torque = (nodes[..., 0] * grad[..., 1] - nodes[..., 1] * grad[..., 0]) @ m  # (B, dof)
+        fx, fy = grad[..., 0] @ m, grad[..., 1] @ m
+        lever = joints[..., 0] * fy - joints[..., 1] * fx
+        return self.robot.chain.joint_signs * (torque - lever)
+
+    @property
+    def downstream(self) -> np.ndarray:
+        """(N, dof) 1.0 where node n is moved by joint j (body_n > j)."""
+        return (self.body[:, None] > np.arange(self.robot.dof)).astype(float)
 
     def positions_and_jacobians(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(B, N, 2) node positions and (B, N, 2, dof) Jacobians ∂p/∂q at q (B, dof)."""
         q = self.robot.check_q(q)
-        p = self.robot.chain.transform(self.nodes0, self.body, q)
+        p = self.positions(q)
         return p, self.robot.chain.jacobian(p, self.body, q)
 
     def batch(
@@ -239,6 +289,11 @@ class RobotGraph:
         next = torch.as_tensor(self.next, device=device).expand(b, -1)
         mask = torch.ones(b, self.n_nodes, dtype=torch.bool, device=device)
         return GraphBatch(nodes, prev, next, mask)
+
+
+def _rotate(c: np.ndarray, s: np.ndarray, x: float, y: float) -> np.ndarray:
+    """(B, 2) rotations R(θ) (x, y) given cos θ and sin θ (B,)."""
+    return np.stack([c * x - s * y, s * x + c * y], -1)
 
 
 @lru_cache(maxsize=64)

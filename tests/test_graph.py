@@ -99,6 +99,23 @@ def test_robot_graph_positions_and_jacobians(max_edge):
     assert len(cyc) == robot.n_links
 
 
+@pytest.mark.parametrize(("env", "max_edge"), [("c", None), ("c", 0.1), ("fetch", None)])
+def test_batch_kinematics_and_pullback_equal_pinocchio(env, max_edge):
+    robot = gp.make_scene(env).robot
+    q = robot.sample(5, seed=2)
+    nodes, joints = robot_graph(robot).kinematics(q)
+    np.testing.assert_allclose(nodes, robot.node_positions_pinocchio(q), atol=1e-12)
+    np.testing.assert_allclose(joints, robot.chain.joint_positions(q), atol=1e-12)
+    graph = robot_graph(robot, max_edge)
+    nodes, joints = graph.kinematics(q)
+    grad = np.random.default_rng(0).normal(size=nodes.shape)
+    _, jac = graph.positions_and_jacobians(q)
+    if max_edge is None:
+        np.testing.assert_allclose(jac, robot.node_jacobians_pinocchio(q), atol=1e-12)
+    expected = np.einsum("bni,bnij->bj", grad, jac)
+    np.testing.assert_allclose(graph.pullback(nodes, joints, grad), expected, atol=1e-12)
+
+
 def test_collate_pads_graphs_of_different_sizes():
     a = (np.zeros((3, 2)), np.array([2, 0, 1]), np.array([1, 2, 0]))
     b = (np.ones((5, 2)), np.array([4, 0, 1, 2, 3]), np.array([1, 2, 3, 4, 0]))

@@ -8,7 +8,13 @@ import torch
 
 import gdnplan as gp
 from gdnplan.data import load
-from gdnplan.models.graphdistnet import GraphDistNet, GraphDistNetConfig, GraphDistNetModel
+from gdnplan.graph import obstacle_graph, robot_graph, scene_obstacles
+from gdnplan.models.graphdistnet import (
+    GraphDistNet,
+    GraphDistNetConfig,
+    GraphDistNetModel,
+    _repeat,
+)
 from gdnplan.train import evaluate
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -74,8 +80,6 @@ def test_lean_first_layer_equals_naive_per_edge_reference():
     torch.manual_seed(1)
     scene, model = random_model("b")
     net = model.net
-    from gdnplan.graph import obstacle_graph, robot_graph, scene_obstacles
-
     q = scene.robot.sample(4, seed=0)
     robot = robot_graph(scene.robot).batch(robot_graph(scene.robot).positions(q))
     polys, sizes = scene_obstacles([scene] * 4)
@@ -91,6 +95,55 @@ def test_lean_first_layer_equals_naive_per_edge_reference():
         feat = torch.cat([z_j - z[:, :, None], (z_bar - z)[:, :, None].expand(-1, -1, 3, -1)], -1)
         naive = net.convs[k][0](feat)
         torch.testing.assert_close(lean, naive, atol=1e-5, rtol=1e-5)
+
+
+def reference_distance_and_grad(
+    model: GraphDistNetModel, scene: gp.Scene, q: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """d̂ and ∂d̂/∂q by the padded :meth:`GraphDistNet.forward` and the node Jacobians."""
+    graph = robot_graph(scene.robot, model.config.max_edge)
+    obstacles = obstacle_graph(*scene_obstacles([scene]), model.config.max_edge, dtype=model.dtype)
+    nodes, jac = graph.positions_and_jacobians(q)
+    x = torch.tensor(nodes, dtype=model.dtype, requires_grad=True)
+    d = model.net(graph.batch(x, dtype=model.dtype), _repeat(obstacles, len(q)))
+    (dx,) = torch.autograd.grad(d.sum(), x)
+    return d.detach().double().numpy(), np.einsum("bni,bnij->bj", dx.double().numpy(), jac)
+
+
+LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad the candidates
+    ("a", "a"),
+    ("e", "e"),
+    ("fetch", "ur5e"),
+    ("b", {"activation": "silu", "max_edge": 0.2}),
+    ("d", {"mlp": ()}),
+]
+
+
+@pytest.mark.parametrize(("env", "net"), LEAN_CASES)
+def test_lean_inference_equals_reference_forward(env, net):
+    if isinstance(net, str):
+        model, scene = shipped(net), gp.make_scene(env, seed=3)
+    else:
+        scene, model = random_model(env, **net)
+    q = scene.robot.sample(70, seed=1)  # two chunks, the second partial
+    d_ref, g_ref = reference_distance_and_grad(model, scene, q)
+    d, g = model.distance_and_grad(scene, q)
+    scale = np.abs(g_ref).max()
+    np.testing.assert_allclose(d, d_ref, atol=2e-6 * model.config.scale)
+    np.testing.assert_allclose(g, g_ref, atol=1e-4 * scale)
+    np.testing.assert_allclose(model.distance(scene, q), d, atol=2e-6 * model.config.scale)
+
+
+def test_scene_cache_follows_the_scene_object():
+    scene, model = random_model("e")
+    other = gp.make_scene("e", seed=6)
+    q = scene.robot.sample(8, seed=0)
+    d = model.distance(scene, q)
+    d_other = model.distance(other, q)
+    _, fresh = random_model("e")
+    np.testing.assert_array_equal(d_other, fresh.distance(other, q))
+    assert np.abs(d - d_other).min() > 1e-5
+    np.testing.assert_array_equal(model.distance(scene, q), d)
 
 
 def sweep_jumps(model, scene: gp.Scene, joints: list[int], n: int = 200) -> np.ndarray:
