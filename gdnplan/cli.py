@@ -221,6 +221,54 @@ def table1_command(
             typer.echo(f"wrote {path}", err=True)
 
 
+@reproduce_app.command("table2")
+def table2_command(
+    n: int = typer.Option(20, help="Problems per setting (the paper: 20)."),
+    settings: str = typer.Option("b,d,fetch", help="Settings: b, d, fetch (comma-separated)."),
+    methods: str = typer.Option(
+        "GraphDistNet,ClearanceNet,DiffCo,coal", help="Collision models (comma-separated)."
+    ),
+    solvers: str = typer.Option("ipopt,adam", help="Optimisers: ipopt, adam (comma-separated)."),
+    seed: int = typer.Option(0, help="Problem seed."),
+    threads: int = typer.Option(1, help="torch threads (1 is fastest on a busy 2-core CPU)."),
+    out: Path = typer.Option(Path("results/table2.md"), help="Markdown output (+ .json)."),
+) -> None:
+    """The paper's Table II: every collision model × optimiser on random reaching problems."""
+    import torch
+
+    from . import table2
+
+    chosen = {
+        name: [v.strip() for v in value.split(",") if v.strip()]
+        for name, value in (("settings", settings), ("methods", methods), ("solvers", solvers))
+    }
+    allowed = {"settings": table2.SETTINGS, "methods": table2.METHODS, "solvers": table2.SOLVERS}
+    for name, values in chosen.items():
+        bad = [v for v in values if v not in allowed[name]]
+        if bad or not values:
+            raise InputError(f"--{name}: expected some of {allowed[name]}, got {bad or values}")
+    if n < 1:
+        raise InputError(f"--n: expected ≥ 1, got {n}")
+    torch.set_num_threads(threads)
+    records, skipped = [], []
+    for setting in chosen["settings"]:
+        problems = table2.reaching_problems(setting, n, seed)
+        got, why = table2.run_setting(
+            setting,
+            problems,
+            chosen["methods"],
+            chosen["solvers"],
+            log=lambda m: typer.echo(m, err=True),
+        )
+        records += got
+        skipped += why
+    command = (
+        f"gdnplan reproduce table2 --n {n} --settings {settings} --methods {methods} "
+        f"--solvers {solvers} --seed {seed} --threads {threads}"
+    )
+    typer.echo(table2.write(records, skipped, command, out))
+
+
 @app.command("fetch")
 def fetch_command(
     seed: int = typer.Option(0, help="Fetch layout: 0 canonical, others random storages."),
@@ -338,8 +386,20 @@ def train_command(
     config = GraphDistNetConfig.from_dict(PRESETS[preset]().to_dict() | overrides)
     torch.set_num_threads(threads)
     card = train(
-        env, config, name or preset, n_train, batch, lr, epochs, patience, time_budget, seed,
-        device, data_root=data or DATA_DIR, out=out, run_dir=run_dir,
+        env,
+        config,
+        name or preset,
+        n_train,
+        batch,
+        lr,
+        epochs,
+        patience,
+        time_budget,
+        seed,
+        device,
+        data_root=data or DATA_DIR,
+        out=out,
+        run_dir=run_dir,
         compile=compile,
     )
     typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))

@@ -5,7 +5,15 @@ import pytest
 
 import gdnplan as gp
 from gdnplan.ccd import certify_path, lever_arms, motion_bound, verify_path
-from gdnplan.trajopt import Plan, Problem, TrajoptOptions, plan, straight_line, tip_position
+from gdnplan.trajopt import (
+    Plan,
+    Problem,
+    TrajoptOptions,
+    distance_bounds,
+    plan,
+    straight_line,
+    tip_position,
+)
 
 START, GOAL = [1.3, -2.9], [1.5, 0.1]  # planar2 around env a's square; the straight line hits it
 
@@ -72,6 +80,60 @@ def test_adam_pushes_the_straight_line_out_of_the_square(square):
     result = plan(p, solver="adam")
     assert result.success, result.reason
     assert result.status == "adam: cost below threshold" and result.iterations > 1
+
+
+class Underestimating:
+    """A learned stand-in: coal's distance minus 0.25 m (rates the whole problem too close)."""
+
+    name = "underestimating"
+
+    def distance(self, scene, q):
+        return gp.signed_distance(scene, q) - 0.25
+
+    def distance_and_grad(self, scene, q):
+        d, g = gp.signed_distance_and_grad(scene, q)
+        return d - 0.25, g
+
+
+def test_distance_bounds_relax_only_the_end_segments_a_learned_model_rates_too_close(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=5, margin=0.02)
+    splits = np.array([2, 3, 3, 2])
+    assert np.all(distance_bounds(p, gp.CoalModel(), p.goal, splits, 0.02) == 0.02)
+    bounds = distance_bounds(p, Underestimating(), p.goal, splits, 0.02)
+    d_start, d_goal = gp.signed_distance(square, np.array([START, GOAL])) - 0.25
+    assert min(d_start, d_goal) < 0.02  # the stand-in rates an endpoint below the margin
+    np.testing.assert_allclose(bounds[:2], min(0.02, d_start - 0.005))
+    np.testing.assert_allclose(bounds[2:8], 0.02)
+    np.testing.assert_allclose(bounds[8:], min(0.02, d_goal - 0.005))
+
+
+class GoalDip:
+    """A learned stand-in: coal's distance minus a 0.4 m dip at the goal (width 0.1 rad)."""
+
+    name = "goal dip"
+
+    def __init__(self, goal):
+        self.goal = np.asarray(goal)
+
+    def _dip(self, q):
+        return 0.4 * np.exp(-np.sum((q - self.goal) ** 2, axis=-1) / 0.02)
+
+    def distance(self, scene, q):
+        return gp.signed_distance(scene, q) - self._dip(q)
+
+    def distance_and_grad(self, scene, q):
+        d, g = gp.signed_distance_and_grad(scene, q)
+        dip = self._dip(q)
+        return d - dip, g + dip[:, None] * (q - self.goal) / 0.01
+
+
+def test_adam_stops_with_a_learned_model_rating_the_goal_below_the_margin(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=20)
+    model = GoalDip(GOAL)
+    assert model.distance(square, np.array([GOAL]))[0] < 0  # no path has d̂ ≥ margin at the goal
+    result = plan(p, collision=model, solver="adam")
+    assert result.status == "adam: cost below threshold", result.reason
+    assert result.success, result.reason
 
 
 TOML = """
