@@ -1,20 +1,26 @@
 """GraphDistNet vs coal: seconds for a batch of configurations, measured side by side in one run.
 
-Usage: python benchmarks/inference.py [--n 5000] [--repeats 3] [--envs a b c d e] [--device cpu]
+Usage: python benchmarks/inference.py [--n 5000] [--repeats 3] [--envs a b c d e fetch]
+[--threads 1]
 
-For each environment with shipped weights (``weights/<env>.safetensors``), on one scene (seed 0)
-and the same n uniformly random configurations: coal distance and distance + exact gradient
-(broad phase, all cores) and GraphDistNet distance and distance + ∂d̂/∂q (float32, all cores),
-best of the repeats. Also the achieved GFLOP/s of the GraphDistNet forward pass (FLOPs counted
-by torch's FlopCounterMode) against the GFLOP/s of a large float32 matmul on the same machine.
+For each scene with shipped weights (``weights/<env>.safetensors``; the UR5e ``fetch`` scene
+uses ``weights/ur5e.safetensors``), on one scene (seed 0) and the same n uniformly random
+configurations: coal distance and distance + exact gradient (bounding-circle broad phase,
+batches split over all cores by processes) and GraphDistNet distance and distance + ∂d̂/∂q
+(float32, ``--threads`` torch threads), best of the repeats, after one warm-up call each. Also
+the achieved GFLOP/s of the GraphDistNet distance pass (matmul FLOPs counted by torch's
+FlopCounterMode) against the GFLOP/s of a 2048² float32 matmul with the same threads, and the
+machine, date and load average (other jobs may share the CPU: compare ratios, not seconds).
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
 import os
-import platform
+import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import torch
@@ -24,9 +30,11 @@ import gdnplan as gp
 from gdnplan import distance
 
 WEIGHTS = Path(__file__).resolve().parent.parent / "weights"
+WEIGHTS_FOR_SCENE = {"fetch": "ur5e"}  # scene name -> weights name, where they differ
 
 
-def best_time(fn, repeats: int) -> float:
+def best_time(fn: Callable[[], object], repeats: int) -> float:
+    """Shortest wall time (s) of ``repeats`` calls of ``fn``."""
     times = []
     for _ in range(repeats):
         start = time.perf_counter()
@@ -38,51 +46,71 @@ def best_time(fn, repeats: int) -> float:
 def matmul_gflops(size: int = 2048, repeats: int = 5) -> float:
     """GFLOP/s of a float32 (size × size) matmul: the practical peak of this CPU."""
     a, b = torch.randn(size, size), torch.randn(size, size)
+    a @ b
     seconds = best_time(lambda: a @ b, repeats)
     return 2 * size**3 / seconds / 1e9
 
 
-def forward_flops(model, scene, q) -> int:
+def forward_flops(model, scene: gp.Scene, q) -> int:
+    """Matmul FLOPs of ``model.distance(scene, q)``."""
     with FlopCounterMode(display=False) as counter:
         model.distance(scene, q)
     return counter.get_total_flops()
+
+
+def machine() -> str:
+    """CPU model name (lscpu), core count and torch version."""
+    out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
+    name = next((ln.split(":", 1)[1].strip() for ln in out.splitlines() if "Model name" in ln), "?")
+    return f"{name}, {os.cpu_count()} cores, torch {torch.__version__}"
+
+
+def row(env: str, n: int, repeats: int, peak: float) -> str:
+    """One table row: seconds of coal and GraphDistNet for n configurations of scene ``env``."""
+    path = WEIGHTS / f"{WEIGHTS_FOR_SCENE.get(env, env)}.safetensors"
+    if not path.exists():
+        return f"| {env} | (no weights at {path.name}) ||||||"
+    scene = gp.make_scene(env, seed=0)
+    q = scene.robot.sample(n, seed=0)
+    model = gp.load_model(path)
+    distance.checker(scene)
+    calls = {
+        "coal d": lambda: gp.signed_distance(scene, q),
+        "coal d+grad": lambda: gp.signed_distance_and_grad(scene, q),
+        "GDN d": lambda: model.distance(scene, q),
+        "GDN d+grad": lambda: model.distance_and_grad(scene, q),
+    }
+    for fn in calls.values():  # warm-up: caches, allocator, lazy initialisation
+        fn()
+    t = {name: best_time(fn, repeats) for name, fn in calls.items()}
+    gflops = forward_flops(model, scene, q) / t["GDN d"] / 1e9
+    seconds = " | ".join(f"{s:.3f}" for s in t.values())
+    ratios = f"{t['GDN d'] / t['coal d']:.1f}× | {t['GDN d+grad'] / t['coal d+grad']:.1f}×"
+    share = f"{gflops:.1f} ({100 * gflops / peak:.0f} %)"
+    return f"| {env} ({scene.robot.name}) | {seconds} | {ratios} | {share} |"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--n", type=int, default=5000)
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--envs", nargs="+", default=["a", "b", "c", "d", "e"])
+    parser.add_argument("--envs", nargs="+", default=["a", "b", "c", "d", "e", "fetch"])
+    parser.add_argument("--threads", type=int, default=1, help="torch intra-op threads")
     args = parser.parse_args()
-    torch.set_num_threads(os.cpu_count() or 1)
+    torch.set_num_threads(args.threads)
     peak = matmul_gflops()
-    machine = platform.processor() or platform.machine()
-    print(f"machine: {machine}, {os.cpu_count()} cores, torch {torch.__version__}, n = {args.n}")
-    print(f"float32 matmul peak: {peak:.1f} GFLOP/s")
+    now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    print(f"machine: {machine()}; torch threads {args.threads}; n = {args.n}; {now}")
+    print(f"load average at start: {os.getloadavg()}")
+    print(f"float32 matmul peak ({args.threads} threads): {peak:.1f} GFLOP/s")
     print(
-        "| env | coal d (s) | coal d+grad (s) | GDN d (s) | GDN d+grad (s) "
-        "| GDN/coal (d+grad) | GDN GFLOP/s (share of peak) |"
+        "| env (robot) | coal d (s) | coal d+grad (s) | GDN d (s) | GDN d+grad (s) "
+        "| GDN/coal d | GDN/coal d+grad | GDN d GFLOP/s (share of peak) |"
     )
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for env in args.envs:
-        path = WEIGHTS / f"{env}.safetensors"
-        if not path.exists():
-            print(f"| {env} | (no weights at {path.name}) |||||")
-            continue
-        scene = gp.make_scene(env, seed=0)
-        q = scene.robot.sample(args.n, seed=0)
-        model = gp.load_model(path)
-        distance.checker(scene)
-        model.distance(scene, q[:10])  # warm-up
-        t_cd = best_time(lambda s=scene, q=q: gp.signed_distance(s, q), args.repeats)
-        t_cg = best_time(lambda s=scene, q=q: gp.signed_distance_and_grad(s, q), args.repeats)
-        t_gd = best_time(lambda s=scene, q=q, m=model: m.distance(s, q), args.repeats)
-        t_gg = best_time(lambda s=scene, q=q, m=model: m.distance_and_grad(s, q), args.repeats)
-        gflops = forward_flops(model, scene, q) / t_gd / 1e9
-        print(
-            f"| {env} | {t_cd:.3f} | {t_cg:.3f} | {t_gd:.3f} | {t_gg:.3f} | {t_gg / t_cg:.1f}× "
-            f"| {gflops:.1f} ({100 * gflops / peak:.0f} %) |"
-        )
+        print(row(env, args.n, args.repeats, peak), flush=True)
+    print(f"load average at end: {os.getloadavg()}")
 
 
 if __name__ == "__main__":
