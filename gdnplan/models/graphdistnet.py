@@ -49,6 +49,7 @@ from ..graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_o
 from ..scene import Scene
 
 PAD_DIST2 = 1e6  # squared distance (normalised units²) given to padded candidates
+LEAKY_SLOPE = 0.2  # negative slope of the paper's LeakyReLU
 
 
 @dataclass(frozen=True)
@@ -123,7 +124,7 @@ class GraphDistNetConfig:
 
 
 def _activation(name: str) -> nn.Module:
-    return nn.LeakyReLU(0.2) if name == "leaky_relu" else nn.SiLU()
+    return nn.LeakyReLU(LEAKY_SLOPE) if name == "leaky_relu" else nn.SiLU()
 
 
 def mlp(sizes: list[int], activation: str) -> nn.Sequential:
@@ -193,6 +194,47 @@ def _cross_mix(idx: torch.Tensor, w: torch.Tensor, n_r: int) -> tuple[torch.Tens
     m_ro = w.new_zeros(b, n_r, n_o).scatter_add(-1, idx[:, :n_r] - n_r, w[:, :n_r])
     m_or = w.new_zeros(b, n_o, n_r).scatter_add(-1, idx[:, n_r:], w[:, n_r:])
     return m_ro, m_or
+
+
+class _LeakyRingMessages(torch.autograd.Function):
+    """Σ_e g(pre_e) (B, N, H) over the edges e = (prev, next, self) of every node, in place.
+
+    pre_prev/next = u_j − u_i + c_i, pre_self = c_i and g = σ ∘ L_m ∘ σ ∘ … ∘ L_1 ∘ σ with
+    σ = LeakyReLU(0.2) and the hidden linear layers L_l = (W_l, b_l) of h_k. The activations
+    are applied in place and kept (σ(s) > 0 ⇔ s > 0), and the backward pass reuses its
+    buffers: ∂/∂s = σ'(s) ⊙ ∂/∂σ(s), ∂/∂a = (∂/∂s) W. Gradients flow to u and c only
+    (inference: the weights get none).
+    """
+
+    @staticmethod
+    def forward(ctx, u: torch.Tensor, c: torch.Tensor, ring: torch.Tensor, *weights: torch.Tensor):
+        b, n, hd = u.shape
+        pre = u.new_empty(b, 3, n, hd)
+        torch.add(u.index_select(1, ring).view(b, 2, n, hd), (c - u)[:, None], out=pre[:, :2])
+        pre[:, 2] = c
+        acts = [nn.functional.leaky_relu_(pre, LEAKY_SLOPE)]
+        for w, bias in zip(weights[::2], weights[1::2], strict=True):
+            acts.append(
+                nn.functional.leaky_relu_(nn.functional.linear(acts[-1], w, bias), LEAKY_SLOPE)
+            )
+        ctx.save_for_backward(ring, *weights[::2], *acts)
+        return acts[-1].sum(1)
+
+    @staticmethod
+    def backward(ctx, grad: torch.Tensor):
+        ring, *saved = ctx.saved_tensors
+        n_lin = len(saved) // 2
+        ws, acts = saved[:n_lin], saved[n_lin:]
+        g = torch.ops.aten.leaky_relu_backward(
+            grad[:, None].expand_as(acts[-1]), acts[-1], LEAKY_SLOPE, True
+        )
+        for w, a in zip(reversed(ws), reversed(acts[:-1]), strict=True):
+            g = g @ w
+            torch.ops.aten.leaky_relu_backward.grad_input(g, a, LEAKY_SLOPE, True, grad_input=g)
+        b, _, n, hd = g.shape
+        ring_grad = g[:, :2]
+        u_grad = (-ring_grad.sum(1)).index_add_(1, ring, ring_grad.reshape(b, 2 * n, hd))
+        return (u_grad, g.sum(1), None, *(None for _ in range(2 * n_lin)))
 
 
 @dataclass(frozen=True)
@@ -423,13 +465,18 @@ class GraphDistNet(nn.Module):
         b, n, hd = v.shape
         n_r = mix[0].shape[1]
         v_bar = torch.cat([mix[0] @ v[:, n_r:], mix[1] @ v[:, :n_r]], 1)  # Σ_c w_ic v_c
-        self_edge = (v_bar - v + first.bias)[:, None]  # (B, 1, N, H)
-        ring_edges = u.index_select(1, ring).view(b, 2, n, hd) - u[:, None] + self_edge
-        pre = torch.cat([ring_edges, self_edge], 1)  # (B, 3, N, H)
-        if not rest:
-            return pre.sum(1)
+        c = v_bar - v + first.bias  # (B, N, H), pre-activation of the self edge
+        if rest and self.config.activation == "leaky_relu":
+            hidden = [m for m in rest[:-1] if isinstance(m, nn.Linear)]
+            msg = _LeakyRingMessages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
+        else:
+            ring_edges = u.index_select(1, ring).view(b, 2, n, hd) - u[:, None] + c[:, None]
+            pre = torch.cat([ring_edges, c[:, None]], 1)  # (B, 3, N, H)
+            if not rest:
+                return pre.sum(1)
+            msg = rest[:-1](pre).sum(1)
         last = rest[-1]
-        return nn.functional.linear(rest[:-1](pre).sum(1), last.weight, 3 * last.bias)
+        return nn.functional.linear(msg, last.weight, 3 * last.bias)
 
     def _lean_readout(self, h: torch.Tensor, score: torch.Tensor, n_r: int) -> torch.Tensor:
         """(B, 2 d_h): :meth:`readout` without padding, scores a⁽ᵏ⁾ᵀ x⁽ᵏ⁾ (B, N) given."""
