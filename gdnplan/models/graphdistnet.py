@@ -28,6 +28,12 @@ y_g⁽ᵏ⁾ = f(Σ_i α_i x_i⁽ᵏ⁾); y_g = max_k y_g⁽ᵏ⁾ element-wise;
 Implementation: dense padded tensors; the first linear layer of h_k is applied per node, not
 per edge, since W (z_j − z_i) = W z_j − W z_i: with W = [W_loc W_rel] and u = z W_locᵀ,
 v = z W_relᵀ (per node), the edge pre-activation is u_j − u_i + v̄_i − v_i + b.
+
+Inference (:class:`GraphDistNetModel`, ``soft_knn``) runs :meth:`GraphDistNet.lean`, the same
+function for one scene without padding: ring neighbours by one shared index, the cross terms
+as dense batched products, the last linear layer of h_k after the sum over the edges and, for
+LeakyReLU, the edge MLP with a hand-written backward (:class:`_LeakyRingMessages`). Tests
+prove it equal to :meth:`GraphDistNet.forward` (values and gradients).
 """
 
 from __future__ import annotations
