@@ -9,7 +9,10 @@ Three settings of 20 random reaching problems each (the paper's):
 
 For (b) and (d) start and goal are uniform random configurations with coal clearance ≥ margin
 + 3 cm whose straight joint-space line is *not* certified free (otherwise there is nothing to
-optimise) and that pass :class:`~gdnplan.trajopt.Problem`'s feasibility checks. Each problem is
+optimise), that pass :class:`~gdnplan.trajopt.Problem`'s feasibility checks and that are known
+to be solvable: RRT-Connect on coal connects them within 10 s (a random pair may lie in
+different components of the free space — the square can wall off the 2-DoF arm — and then
+every method fails; such pairs say nothing about the collision models). Each problem is
 solved with every collision model — coal (exact), GraphDistNet (``weights/<env>``), ClearanceNet
 (``weights/clearancenet_<env>``) and DiffCo (trained on the problem's own scene with coal labels,
 its smooth fitted surrogate as the constraint) — by Ipopt and by the paper's Adam optimiser.
@@ -37,6 +40,7 @@ from .ccd import verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
 from .models import CoalModel, DistanceModel, load_model
+from .rrt import rrt_connect
 from .scene import make_scene
 from .trajopt import Plan, Problem, TrajoptOptions, plan, straight_line
 
@@ -114,7 +118,9 @@ def reaching_problems(setting: str, n: int = 20, seed: int = 0) -> list[Problem]
             p = Problem(scene, q[0], q[1], waypoints=WAYPOINTS[setting], margin=margin)
         except InfeasibleProblemError:
             continue
-        if not verify_path(scene, straight_line(q[0], q[1], p.waypoints), margin=margin)[0]:
+        if verify_path(scene, straight_line(q[0], q[1], p.waypoints), margin=margin)[0]:
+            continue
+        if rrt_connect(scene, q[0], q[1], margin, seed=0, time_limit=10.0).success:
             out.append(p)
     return out
 

@@ -14,7 +14,7 @@ from gdnplan.cli import app
 from gdnplan.trajopt import straight_line
 
 
-def test_reaching_problems_are_deterministic_clear_at_the_ends_and_blocked_between():
+def test_reaching_problems_are_deterministic_clear_at_the_ends_blocked_between_and_solvable():
     problems = table2.reaching_problems("b", n=3, seed=5)
     again = table2.reaching_problems("b", n=3, seed=5)
     for p, q in zip(problems, again, strict=True):
@@ -24,6 +24,7 @@ def test_reaching_problems_are_deterministic_clear_at_the_ends_and_blocked_betwe
         assert np.all(ends > p.margin + 0.03)
         line = straight_line(p.start, p.goal, p.waypoints)
         assert not gp.verify_path(p.scene, line, margin=p.margin)[0]
+        assert gp.plan(p, collision="coal").success  # a solvable problem
 
 
 def test_fetch_problems_are_unseen_random_layouts():
