@@ -156,7 +156,9 @@ def model_factory(method: str, setting: str, weights_dir: Path = WEIGHTS_DIR) ->
         raise InputError(f"method: unknown {method!r}; choose from {METHODS}")
     path = weights_dir / f"{stem}{WEIGHTS_ENV[setting]}.safetensors"
     if not path.exists():
-        raise InputError(f"{method} for setting {setting!r}: no weights at {path}")
+        raise InputError(
+            f"{method} for setting {setting!r}: no weights {path.name} in {weights_dir.name}/"
+        )
     model = load_model(path)
     return lambda problem: model
 
