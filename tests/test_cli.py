@@ -70,14 +70,40 @@ def test_generate_then_train_writes_loadable_weights(tmp_path):
     data = tmp_path / "data"
     for split, n in (("train", 80), ("test", 40)):
         result = runner.invoke(
-            app, ["generate", "--env", "a", "--split", split, "--n", str(n), "--data", str(data),
-                  "--workers", "1"],
+            app,
+            [
+                "generate",
+                "--env",
+                "a",
+                "--split",
+                split,
+                "--n",
+                str(n),
+                "--data",
+                str(data),
+                "--workers",
+                "1",
+            ],
         )
         assert result.exit_code == 0, result.output
     out = tmp_path / "a.safetensors"
     result = runner.invoke(
-        app, ["train", "--env", "a", "--data", str(data), "--out", str(out), "--epochs", "1",
-              "--set", "layers=1", "--run-dir", str(tmp_path / "run")],
+        app,
+        [
+            "train",
+            "--env",
+            "a",
+            "--data",
+            str(data),
+            "--out",
+            str(out),
+            "--epochs",
+            "1",
+            "--set",
+            "layers=1",
+            "--run-dir",
+            str(tmp_path / "run"),
+        ],
     )
     assert result.exit_code == 0, result.output
     card = json.loads(out.with_suffix(".json").read_text())
