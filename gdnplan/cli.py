@@ -230,6 +230,7 @@ def table2_command(
     ),
     solvers: str = typer.Option("ipopt,adam", help="Optimisers: ipopt, adam (comma-separated)."),
     seed: int = typer.Option(0, help="Problem seed."),
+    first: int = typer.Option(0, help="Run problems first … n − 1 only (split a run)."),
     threads: int = typer.Option(1, help="torch threads (1 is fastest on a busy 2-core CPU)."),
     out: Path = typer.Option(Path("results/table2.md"), help="Markdown output (+ .json)."),
 ) -> None:
@@ -252,19 +253,20 @@ def table2_command(
     torch.set_num_threads(threads)
     records, skipped = [], []
     for setting in chosen["settings"]:
-        problems = table2.reaching_problems(setting, n, seed)
+        problems = table2.reaching_problems(setting, n, seed)[first:]
         got, why = table2.run_setting(
             setting,
             problems,
             chosen["methods"],
             chosen["solvers"],
             log=lambda m: typer.echo(m, err=True),
+            first=first,
         )
         records += got
         skipped += why
     command = (
         f"gdnplan reproduce table2 --n {n} --settings {settings} --methods {methods} "
-        f"--solvers {solvers} --seed {seed} --threads {threads}"
+        f"--solvers {solvers} --seed {seed} --first {first} --threads {threads}"
     )
     typer.echo(table2.write(records, skipped, command, out))
 

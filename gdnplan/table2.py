@@ -171,8 +171,11 @@ def run_setting(
     options: TrajoptOptions | None = None,
     weights_dir: Path = WEIGHTS_DIR,
     log: Callable[[str], None] = print,
+    first: int = 0,
 ) -> tuple[list[Record], list[str]]:
     """Solve every problem with every available method and solver.
+
+    ``problems[0]`` is problem number ``first`` of the setting (to split a run over processes).
 
     Returns:
         The records, and one line per method skipped (no weights) saying why.
@@ -184,7 +187,8 @@ def run_setting(
             factories[method] = model_factory(method, setting, weights_dir)
         except InputError as e:
             skipped.append(str(e))
-    for i, problem in enumerate(tqdm(problems, desc=f"table2 {setting}", mininterval=5)):
+    bar = tqdm(problems, desc=f"table2 {setting}", mininterval=5)
+    for i, problem in enumerate(bar, start=first):
         for method, factory in factories.items():
             start = time.perf_counter()
             model = factory(problem)  # DiffCo trains here, once for both solvers
