@@ -310,7 +310,8 @@ class TrajoptOptions:
         learned_margin: extra constraint margin (m) for learned models in the first solve;
             later rounds add the overestimate coal finds (see ``_solve_refined``).
         rrt_clearance: extra clearance (m) above the margin demanded of seed paths (at most
-            half the start's and goal's own clearance above the margin).
+            half the start's and goal's own clearance above the margin); when RRT-Connect finds
+            no such path, the same attempt retries demanding the margin only (narrow passages).
         rrt_time: time limit of one RRT-Connect run (s).
         rrt_step: RRT-Connect extension (rad, joint-space 2-norm); long steps were fastest on
             environment (d), narrow passages (fetch) may need ~0.3.
@@ -490,17 +491,21 @@ def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
                 guess = np.clip(guess, problem.lower, problem.upper)
             yield "straight line" + (f" (perturbed {attempt})" if attempt else ""), guess
             continue
-        guess, _ = seed_path(
-            problem.scene,
-            problem.start,
-            goal,
-            problem.waypoints,
-            clearance,
-            seed=seed + attempt,
-            time_limit=opts.rrt_time,
-            step=opts.rrt_step,
-        )
-        yield f"RRT-Connect seed {seed + attempt}", guess
+        label = f"RRT-Connect seed {seed + attempt}"
+        for demand in dict.fromkeys((clearance, problem.margin)):  # narrow passage: margin only
+            guess, _ = seed_path(
+                problem.scene,
+                problem.start,
+                goal,
+                problem.waypoints,
+                demand,
+                seed=seed + attempt,
+                time_limit=opts.rrt_time,
+                step=opts.rrt_step,
+            )
+            if guess is not None:
+                break
+        yield label + (" (clearance = margin)" if demand < clearance else ""), guess
 
 
 def _line_free(problem: Problem, line: np.ndarray) -> bool:

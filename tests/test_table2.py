@@ -86,3 +86,10 @@ def test_cli_rejects_unknown_settings():
     result = CliRunner().invoke(app, ["reproduce", "table2", "--settings", "z"])
     assert result.exit_code != 0
     assert "--settings" in str(result.exception) + result.output
+
+
+def test_a_narrow_passage_is_seeded_at_the_margin_when_extra_clearance_fails():
+    problem = table2.reaching_problems("b", n=10, seed=0)[9]  # passage narrower than 4 cm
+    result = gp.plan(problem, collision="coal", seed=9)
+    assert result.success, result.reason
+    assert "(clearance = margin)" in result.reason
