@@ -296,6 +296,11 @@ Notes:
   certificate included). DiffCo is trained per problem on its own scene (coal labels, Fastron,
   then the fitted surrogate); that training is shown separately as (+… training).
 - The paper ran Adam only; its numbers are beside our Adam rows. Ipopt is our default solver.
+- Each solve's solver status is in the JSON beside this file. In the fetch setting the learned
+  models rate the grasp pose (fingers around the stick, 2 cm from it) below the margin, so
+  Ipopt stops with Infeasible_Problem_Detected; the path accepted is then its last iterate,
+  close to the coal-checked RRT-Connect seed, certified by coal like every other path (hence
+  the learned rows' higher path cost there).
 - There is no ClearanceNet for the fetch layouts: its fixed-size input encodes environments
   (a)–(e) only (the paper's fetch ClearanceNet is not described well enough to rebuild).
 """
