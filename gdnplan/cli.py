@@ -26,6 +26,18 @@ def _commands() -> None:
     """Collision-free trajectory planning with GraphDistNet."""
 
 
+THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
+
+
+def set_threads(threads: int) -> None:
+    """Set torch's intra-op threads; raises InputError unless threads ≥ 1."""
+    if threads < 1:
+        raise InputError(f"--threads: expected ≥ 1, got {threads}")
+    import torch
+
+    torch.set_num_threads(threads)
+
+
 def parse_vector(text: str, name: str) -> np.ndarray:
     """'0.1, -0.2, 0.3' -> array; raises InputError naming ``name``."""
     try:
@@ -81,6 +93,7 @@ def plan_command(
     seed: int = typer.Option(0, help="Seed of the sampling-based initial guesses."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
     view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
 ) -> None:
     """Plan a collision-free trajectory; success is certified by a dense coal check.
@@ -89,6 +102,7 @@ def plan_command(
     """
     from .trajopt import Problem, plan
 
+    set_threads(threads)
     if view3d:  # fail before planning, not after
         from .viz3d import require_meshcat
 
@@ -231,12 +245,10 @@ def table2_command(
     solvers: str = typer.Option("ipopt,adam", help="Optimisers: ipopt, adam (comma-separated)."),
     seed: int = typer.Option(0, help="Problem seed."),
     first: int = typer.Option(0, help="Run problems first … n − 1 only (split a run)."),
-    threads: int = typer.Option(1, help="torch threads (1 is fastest on a busy 2-core CPU)."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
     out: Path = typer.Option(Path("results/table2.md"), help="Markdown output (+ .json)."),
 ) -> None:
     """The paper's Table II: every collision model × optimiser on random reaching problems."""
-    import torch
-
     from . import table2
 
     chosen = {
@@ -250,7 +262,7 @@ def table2_command(
             raise InputError(f"--{name}: expected some of {allowed[name]}, got {bad or values}")
     if n < 1:
         raise InputError(f"--n: expected ≥ 1, got {n}")
-    torch.set_num_threads(threads)
+    set_threads(threads)
     records, skipped = [], []
     for setting in chosen["settings"]:
         problems = table2.reaching_problems(setting, n, seed)[first:]
@@ -278,6 +290,7 @@ def fetch_command(
     weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/ur5e)."),
     animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
     view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
 ) -> None:
     """The UR5e fetch: approach, reach in, grasp, lift, bring the stick out, retreat.
@@ -286,6 +299,7 @@ def fetch_command(
     """
     from .fetch import run_fetch
 
+    set_threads(threads)
     if view3d:  # fail before planning, not after
         from .viz3d import require_meshcat
 

@@ -126,3 +126,9 @@ def test_train_and_generate_reject_bad_options(args, message):
     result = runner.invoke(app, args)
     assert result.exit_code != 0
     assert message in str(result.exception) or message in result.output
+
+
+def test_plan_rejects_zero_threads():
+    result = runner.invoke(app, ["plan", "problems/planar2_square.toml", "--threads", "0"])
+    assert result.exit_code != 0
+    assert "--threads" in str(result.exception) + result.output
