@@ -377,6 +377,9 @@ def train_command(
     out: Path = typer.Option(None, help="Weights path (default: weights/<env>.safetensors)."),
     run_dir: Path = typer.Option(None, help="Checkpoints, loss curve (default runs/<env>-<name>)."),
     compile: bool = typer.Option(False, "--compile", help="torch.compile the training step."),
+    init: Path = typer.Option(
+        None, help="Fine-tune from these GraphDistNet weights (their card's config; --set applies)."
+    ),
 ) -> None:
     """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
     if model == "clearancenet":
@@ -399,7 +402,8 @@ def train_command(
         overrides = {k: json.loads(v) for k, v in (s.split("=", 1) for s in set_)}
     except ValueError as e:
         raise InputError(f"--set: expected key=json_value, got {set_}") from e
-    config = GraphDistNetConfig.from_dict(PRESETS[preset]().to_dict() | overrides)
+    base = PRESETS[preset]().to_dict() if init is None else _card_config(init)
+    config = GraphDistNetConfig.from_dict(base | overrides)
     torch.set_num_threads(threads)
     card = train(
         env,
@@ -417,8 +421,17 @@ def train_command(
         out=out,
         run_dir=run_dir,
         compile=compile,
+        init=init,
     )
     typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
+
+
+def _card_config(weights: Path) -> dict:
+    """The config of the JSON card beside ``weights`` (InputError when it is missing)."""
+    card = weights.with_suffix(".json")
+    if not card.exists():
+        raise InputError(f"--init: no card {card.name} beside {weights}")
+    return json.loads(card.read_text())["config"]
 
 
 @app.command("field")

@@ -20,6 +20,7 @@ Metrics (:func:`evaluate`, paper Table I), against coal labels on a held-out spl
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -35,6 +36,7 @@ from scipy.stats import rankdata
 from tqdm import tqdm
 
 from .data import DATA_DIR, Dataset, env_robot, load, split_dir
+from .errors import InputError
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
 
@@ -231,6 +233,20 @@ def _load_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam) -> di
     return state
 
 
+def _load_init(net: GraphDistNet, path: Path) -> None:
+    """Load the weights at ``path`` into ``net``; InputError if missing or of another shape."""
+    if not path.exists():
+        raise InputError(f"--init: {path} does not exist")
+    try:
+        net.load_state_dict(load_file(str(path)))
+    except RuntimeError as e:
+        raise InputError(f"--init: {path} does not fit this architecture ({e})") from e
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
 def _write_json(path: Path, obj: dict) -> None:
     tmp = path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(obj, indent=2, default=float))
@@ -267,6 +283,7 @@ def train(
     out: Path | str | None = None,
     run_dir: Path | str | None = None,
     compile: bool = False,
+    init: Path | str | None = None,
 ) -> dict:
     """Train GraphDistNet on ``data/<env>/train``, evaluate on ``data/<env>/test``, save weights.
 
@@ -280,6 +297,8 @@ def train(
         out: weights path (default ``weights/<env>.safetensors``; the card goes beside it).
         compile: ``torch.compile`` the training step (≈ 3× faster on CPU after a few minutes
             of compilation); validation and evaluation stay eager.
+        init: fine-tune: start from these weights (same architecture as ``config``) instead
+            of a random initialisation; ignored when the run resumes from its checkpoint.
 
     Returns:
         The card written beside the weights (config, data, training log, test metrics).
@@ -298,6 +317,8 @@ def train(
     train_t = tensors(full.subset(order[n_val:]), config)
     val_t = tensors(full.subset(order[:n_val]), config)
     net = GraphDistNet(config).to(device)
+    if init is not None:
+        _load_init(net, Path(init))
     step_net = torch.compile(net, dynamic=True) if compile else net
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     ckpt = run_dir / "checkpoint.safetensors"
@@ -404,6 +425,8 @@ def train(
         "test": test,
         "git_sha": git_sha(),
     }
+    if init is not None:
+        card["init"] = {"path": str(init), "sha256": _sha256(Path(init))}
     save_weights(net.cpu(), card, out)
     return card
 

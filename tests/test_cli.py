@@ -113,6 +113,18 @@ def test_generate_then_train_writes_loadable_weights(tmp_path):
     d = model.distance(scene, scene.robot.sample(5, seed=0))
     assert d.shape == (5,) and np.isfinite(d).all()
 
+    # fine-tune from those weights: zero learning rate keeps them, the card records the start
+    tuned = tmp_path / "a_tuned.safetensors"
+    args = ["train", "--env", "a", "--data", str(data), "--out", str(tuned), "--epochs", "1",
+            "--lr", "0", "--init", str(out), "--run-dir", str(tmp_path / "run2")]  # fmt: skip
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    card = json.loads(tuned.with_suffix(".json").read_text())
+    assert card["config"]["layers"] == 1 and card["init"]["path"] == str(out)
+    np.testing.assert_allclose(
+        gp.load_model(tuned).distance(scene, scene.robot.sample(5, seed=0)), d
+    )
+
 
 @pytest.mark.parametrize(
     ("args", "message"),
@@ -120,6 +132,7 @@ def test_generate_then_train_writes_loadable_weights(tmp_path):
         (["train", "--env", "a", "--model", "svm"], "--model: expected"),
         (["train", "--env", "a", "--preset", "fast"], "--preset: expected"),
         (["generate", "--env", "a", "--split", "val"], "--split: expected"),
+        (["train", "--env", "a", "--init", "missing.safetensors"], "--init: no card"),
     ],
 )
 def test_train_and_generate_reject_bad_options(args, message):
