@@ -20,7 +20,6 @@ Metrics (:func:`evaluate`, paper Table I), against coal labels on a held-out spl
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -37,6 +36,7 @@ from tqdm import tqdm
 
 from .data import DATA_DIR, Dataset, env_robot, load, split_dir
 from .errors import InputError
+from .evaluate import sha256_prefix
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
 
@@ -243,10 +243,6 @@ def _load_init(net: GraphDistNet, path: Path) -> None:
         raise InputError(f"--init: {path} does not fit this architecture ({e})") from e
 
 
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
 def _write_json(path: Path, obj: dict) -> None:
     tmp = path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(obj, indent=2, default=float))
@@ -426,7 +422,7 @@ def train(
         "git_sha": git_sha(),
     }
     if init is not None:
-        card["init"] = {"path": str(init), "sha256": _sha256(Path(init))}
+        card["init"] = {"path": str(init), "sha256_prefix": sha256_prefix(Path(init))}
     save_weights(net.cpu(), card, out)
     return card
 
