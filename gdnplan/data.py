@@ -25,10 +25,13 @@ held) plus the boxes; when holding, the robot carries the layout's stick (length
 width 0.02–0.04 m). ``scene_seed`` is the fetch seed of the sample's layout. With
 ``near`` > 0, that fraction of the samples is concentrated near the task's contacts:
 
-    q = clip(q_ref + ε, limits),  ε ~ N(0, NEAR_SIGMA² I),
+    q = clip(q_ref + ε, limits),  ε ~ N(0, σ² I),  log σ ~ U(log σ_min, log σ_max),
 
 q_ref drawn from the layout's configurations of that gripper state (open/closed: q_home,
-q_pregrasp, q_grasp; holding: q_lift, q_out), where uniform samples rarely fall.
+q_pregrasp, q_grasp; holding: q_grasp, q_lift, q_out), where uniform samples rarely fall, and
+(σ_min, σ_max) = NEAR_SIGMA: the log-uniform scale puts samples at every distance from the
+contacts, down to the millimetres of the stick resting on its shelf (at 0.005 rad the tcp moves
+≈ 3 mm).
 
 Shard arrays (n samples, P obstacles of at most V vertices, N robot nodes):
 
@@ -75,11 +78,11 @@ ENVS = (*ENV_ROBOT, "ur5e")
 UR5E_LAYOUTS = 300  # fetch layouts per split
 FETCH_SEED_BASE = 10_000  # first fetch seed of the dataset layouts (benchmarks use smaller)
 CANONICAL_SHARE = 0.1  # fraction of ur5e train samples on the canonical layout (fetch seed 0)
-NEAR_SIGMA = 0.2  # rad: spread of the near-contact ur5e samples around the task configurations
+NEAR_SIGMA = (0.005, 0.2)  # rad: range of the log-uniform spread of the near-contact samples
 NEAR_REFS = {  # gripper state -> fetch configurations the near-contact samples spread around
     "open": ("q_home", "q_pregrasp", "q_grasp"),
     "closed": ("q_home", "q_pregrasp", "q_grasp"),
-    "holding": ("q_lift", "q_out"),
+    "holding": ("q_grasp", "q_lift", "q_out"),
 }
 
 
@@ -232,7 +235,8 @@ def make_ur5e_shard(seed: int, start: int, n: int, near: float = 0.0) -> Dataset
         q[i] = robot.sample(1, seed=[seed, start + i])[0]
         if is_near[i]:
             ref = base.info[str(rng.choice(NEAR_REFS[GRIPPER_STATES[gripper[i]]]))]
-            q[i] = np.clip(ref + rng.normal(0.0, NEAR_SIGMA, 3), robot.lower, robot.upper)
+            sigma = np.exp(rng.uniform(*np.log(NEAR_SIGMA)))
+            q[i] = np.clip(ref + rng.normal(0.0, sigma, 3), robot.lower, robot.upper)
         di, gi = signed_distance_and_grad(scene, q[i][None])
         d[i], grad[i] = di[0], gi[0]
         polys.append(list(obstacles))

@@ -107,6 +107,6 @@ def test_ur5e_near_contact_samples_spread_around_the_task_configurations():
         assert ds.d[i] == pytest.approx(d[0], abs=1e-9)
         fetch = gp.make_scene("fetch", seed=int(ds.scene_seed[i]))
         refs = [fetch.info[k] for k in ("q_home", "q_pregrasp", "q_grasp", "q_lift", "q_out")]
-        assert min(np.abs(ds.q[i] - r).max() for r in refs) < 6 * data.NEAR_SIGMA
+        assert min(np.abs(ds.q[i] - r).max() for r in refs) < 6 * max(data.NEAR_SIGMA)
     with pytest.raises(gp.InputError):
         data.generate("d", 10, 0, "unused", near=0.5)
