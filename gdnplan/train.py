@@ -2,7 +2,11 @@
 
 Loss per sample (distances normalised by the config's ``scale`` = reach):
 
-    L = ((d̂ − f) / scale)² + λ · (1 − cos(∂d̂/∂q, ∂f/∂q))      (λ = ``grad_weight``, 0 = paper)
+    L = w · ((d̂ − f) / scale)² / w̄ + λ · (1 − cos(∂d̂/∂q, ∂f/∂q))      (λ = ``grad_weight``, 0 = paper)
+
+    w = 1 + μ · exp(−|f| / s_c)      (μ = ``contact_weight``, 0 = paper; s_c = ``contact_scale``)
+
+(w̄ the batch mean of w: near-contact samples, where the collision label is decided, count more).
 
 with ∂d̂/∂q = Σ_n (∂d̂/∂p_n) ∂p_n/∂q (node Jacobians). Adam, a validation split (10 % of
 train) scored by the loss's terms (MAE/scale + λ · ACD), learning rate halved after 3 epochs
@@ -105,6 +109,15 @@ def tensors(ds: Dataset, config: GraphDistNetConfig) -> Tensors:
         torch.as_tensor(ds.grad, dtype=torch.float32),
         structure,
     )
+
+
+def distance_loss(d_hat: torch.Tensor, d: torch.Tensor, config: GraphDistNetConfig) -> torch.Tensor:
+    """Σ w ((d̂ − f) / scale)² / Σ w over a batch (B,) of predictions d̂ and labels f (m)."""
+    err = ((d_hat - d) / config.scale).square()
+    if config.contact_weight == 0:
+        return err.mean()
+    w = 1 + config.contact_weight * torch.exp(-d.abs() / config.contact_scale)
+    return (w * err).sum() / w.sum()
 
 
 def forward_with_grad(
@@ -350,7 +363,7 @@ def train(
                 loss_g = ((1 - cos) * ok).sum() / ok.sum().clamp_min(1)
             else:
                 d_hat, loss_g = step_net(robot_b, obst_b, gen), torch.zeros((), device=device)
-            loss = ((d_hat - d) / config.scale).square().mean() + config.grad_weight * loss_g
+            loss = distance_loss(d_hat, d, config) + config.grad_weight * loss_g
             opt.zero_grad()
             loss.backward()
             opt.step()

@@ -15,7 +15,7 @@ from gdnplan.models.graphdistnet import (
     GraphDistNetModel,
     _repeat,
 )
-from gdnplan.train import evaluate
+from gdnplan.train import distance_loss, evaluate
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS = ROOT / "weights"
@@ -188,6 +188,15 @@ def test_shipped_weights_on_committed_test_split(env):
     assert m["mae_m"] <= max_mae and m["auc"] >= min_auc and m["acd"] <= max_acd, m
 
 
+def test_contact_weighted_distance_loss_by_hand():
+    d = torch.tensor([0.0, 1.0])  # a contact sample and one 1 m away
+    d_hat = torch.tensor([0.2, 1.4])  # squared errors 0.04 and 0.16 (scale 1)
+    plain = GraphDistNetConfig(scale=1.0)
+    assert float(distance_loss(d_hat, d, plain)) == pytest.approx(0.10)
+    weighted = plain.with_(contact_weight=3.0, contact_scale=0.02)  # w = 4 and 1 + 3e^-50 ≈ 1
+    assert float(distance_loss(d_hat, d, weighted)) == pytest.approx((4 * 0.04 + 0.16) / 5)
+
+
 def test_bad_inputs_raise_input_error():
     scene, model = random_model("a")
     with pytest.raises(gp.InputError):
@@ -200,6 +209,8 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig(cross="nearest")
     with pytest.raises(gp.InputError):
         GraphDistNetConfig(activation="relu")
+    with pytest.raises(gp.InputError):
+        GraphDistNetConfig(contact_weight=-1.0)
     with pytest.raises(gp.InputError):
         GraphDistNetConfig.from_dict({"layers": 2, "width": 3})
     with pytest.raises(gp.InputError):

@@ -73,6 +73,9 @@ class GraphDistNetConfig:
         tau: initial temperature τ of ``soft_knn`` (normalised units², learned per layer).
         max_edge: densify graph edges longer than this (m), or None.
         grad_weight: weight λ of the gradient loss λ · (1 − cos(∂d̂/∂q, ∂f/∂q)).
+        contact_weight: extra weight μ of samples near contact in the distance loss,
+            w = 1 + μ · exp(−|f| / contact_scale) (0 = paper: every sample alike).
+        contact_scale: distance (m) over which the contact weight decays.
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
     """
@@ -87,6 +90,8 @@ class GraphDistNetConfig:
     tau: float = 0.02
     max_edge: float | None = None
     grad_weight: float = 0.0
+    contact_weight: float = 0.0
+    contact_scale: float = 0.02
     scale: float = 1.0
     origin: tuple[float, float] = (0.0, 0.0)
 
@@ -99,6 +104,8 @@ class GraphDistNetConfig:
             raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
         if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
             raise InputError("layers, hidden, cross_k and scale must be positive")
+        if self.contact_weight < 0 or self.contact_scale <= 0:
+            raise InputError("contact_weight must be ≥ 0 and contact_scale positive")
 
     @classmethod
     def faithful(cls, **changes) -> GraphDistNetConfig:
