@@ -247,6 +247,9 @@ def table2_command(
     first: int = typer.Option(0, help="Run problems first … n − 1 only (split a run)."),
     threads: int = typer.Option(1, help=THREADS_HELP),
     out: Path = typer.Option(Path("results/table2.md"), help="Markdown output (+ .json)."),
+    update: bool = typer.Option(
+        False, help="Keep the rows of the earlier run at --out that this run does not redo."
+    ),
 ) -> None:
     """The paper's Table II: every collision model × optimiser on random reaching problems."""
     from . import table2
@@ -279,8 +282,9 @@ def table2_command(
     command = (
         f"gdnplan reproduce table2 --n {n} --settings {settings} --methods {methods} "
         f"--solvers {solvers} --seed {seed} --first {first} --threads {threads}"
+        + (" --update" if update else "")
     )
-    typer.echo(table2.write(records, skipped, command, out))
+    typer.echo(table2.write(records, skipped, command, out, update))
 
 
 @app.command("fetch")

@@ -306,24 +306,70 @@ Notes:
 """
 
 
-def write(records: list[Record], skipped: list[str], command: str, out: Path) -> str:
-    """Write ``out`` (markdown) and the per-solve records beside it (JSON); returns the text."""
-    rows = summarize(records)
-    header = [
-        "# Table II reproduction: trajectory optimisation with each collision model",
-        "",
-        f"- command: `{command}`",
-        f"- date: {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC",
-        f"- machine: {platform.node()}, {platform.machine()}, {os.cpu_count()} cores (shared), "
+def _previous(out: Path) -> tuple[list[dict], list[Record]]:
+    """(runs, records) of an earlier :func:`write` to ``out`` (none when there is none).
+
+    A record file of the first format (a bare list of records) yields one run whose command
+    is the ``- command:`` line of the markdown beside it.
+    """
+    path = out.with_suffix(".json")
+    if not path.exists():
+        return [], []
+    data = json.loads(path.read_text())
+    if isinstance(data, list):
+        lines = out.read_text().splitlines() if out.exists() else []
+
+        def line(key: str) -> str:
+            return next((ln[len(key) :] for ln in lines if ln.startswith(key)), "")
+
+        skipped = line("- skipped: ")
+        run = {
+            "command": line("- command: ").strip("`"),
+            "date": line("- date: "),
+            "machine": line("- machine: "),
+            "rows": "all",
+            "skipped": [] if skipped in ("", "none") else skipped.split("; "),
+            "notes": [ln[2:] for ln in lines if ln.startswith("- commits: ")],
+        }
+        data = {"runs": [run], "records": data}
+    return data["runs"], [Record(**r) for r in data["records"]]
+
+
+def write(
+    records: list[Record], skipped: list[str], command: str, out: Path, update: bool = False
+) -> str:
+    """Write ``out`` (markdown) and the runs and per-solve records beside it (JSON, same name).
+
+    ``update``: keep the rows of the earlier run(s) at ``out`` that this run did not redo
+    (its (setting, method, solver) triples replace theirs). Returns the markdown.
+    """
+    redone = sorted({(r.setting, r.method, r.solver) for r in records})
+    run = {
+        "command": command,
+        "date": f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC",
+        "machine": f"{platform.node()}, {platform.machine()}, {os.cpu_count()} cores (shared), "
         f"load average at the end {os.getloadavg()[0]:.1f}",
-        f"- skipped: {'; '.join(skipped) if skipped else 'none'}",
-        "",
-    ]
-    text = "\n".join(header) + "\n" + markdown(rows) + "\n\n" + NOTES
+        "rows": [" ".join(k) for k in redone],
+        "skipped": skipped,
+    }
+    runs, kept = _previous(out) if update else ([], [])
+    kept = [r for r in kept if (r.setting, r.method, r.solver) not in set(redone)]
+    runs, records = [*runs, run], kept + list(records)
+    order = {k: i for i, k in enumerate(SETTINGS)}
+    records.sort(key=lambda r: order.get(r.setting, len(order)))
+    header = ["# Table II reproduction: trajectory optimisation with each collision model", ""]
+    for r in runs:
+        rows = r["rows"] if isinstance(r["rows"], str) else ", ".join(r["rows"])
+        header.append(f"- command: `{r['command']}` ({r['date']}; rows: {rows})")
+        header += [f"  - {x}" for x in (f"machine: {r['machine']}", *r.get("notes", []))]
+    skipped = list(dict.fromkeys(x for r in runs for x in r.get("skipped", [])))
+    header += [f"- skipped: {'; '.join(skipped) if skipped else 'none'}", ""]
+    text = "\n".join(header) + "\n" + markdown(summarize(records)) + "\n\n" + NOTES
     out.parent.mkdir(parents=True, exist_ok=True)
+    record_file = {"runs": runs, "records": [asdict(r) for r in records]}
     for path, content in (
         (out, text),
-        (out.with_suffix(".json"), json.dumps([asdict(r) for r in records], indent=1)),
+        (out.with_suffix(".json"), json.dumps(record_file, indent=1)),
     ):
         tmp = path.with_name(f".{path.name}.tmp")
         tmp.write_text(content)

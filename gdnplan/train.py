@@ -2,7 +2,7 @@
 
 Loss per sample (distances normalised by the config's ``scale`` = reach):
 
-    L = w · ((d̂ − f) / scale)² / w̄ + λ · (1 − cos(∂d̂/∂q, ∂f/∂q))      (λ = ``grad_weight``, 0 = paper)
+    L = w · ((d̂ − f) / scale)² / w̄ + λ · (1 − cos(∂d̂/∂q, ∂f/∂q))    (λ = ``grad_weight``, 0 = paper)
 
     w = 1 + μ · exp(−|f| / s_c)      (μ = ``contact_weight``, 0 = paper; s_c = ``contact_scale``)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -78,8 +79,23 @@ def test_cli_writes_the_table_and_records(tmp_path):
     assert result.exit_code == 0, result.output
     text = out.read_text()
     assert "| b | coal | ipopt | 1/1 |" in text
-    (record,) = json.loads(out.with_suffix(".json").read_text())
+    (record,) = json.loads(out.with_suffix(".json").read_text())["records"]
     assert record["success"] and record["min_distance"] > 0
+
+
+def test_update_keeps_the_rows_a_run_does_not_redo(tmp_path):
+    out = tmp_path / "table2.md"
+    first = table2.Record("b", "coal", "ipopt", 0, True, 1.0, 0.0, 2.0, 0.03, "ok", "")
+    table2.write([first, replace(first, solver="adam")], ["DiffCo: none"], "run 1", out)
+    redo = replace(first, success=False, time=5.0)
+    text = table2.write([redo], [], "run 2", out, update=True)
+    assert "| b | coal | ipopt | 0/1 |" in text and "| b | coal | adam | 1/1 |" in text
+    assert "`run 1`" in text and "`run 2`" in text and "DiffCo: none" in text
+    saved = json.loads(out.with_suffix(".json").read_text())
+    assert [r["command"] for r in saved["runs"]] == ["run 1", "run 2"]
+    assert len(saved["records"]) == 2
+    text = table2.write([redo], [], "run 3", out)  # without update: only this run's rows
+    assert "adam" not in text.split("Notes:")[0] and "`run 1`" not in text
 
 
 def test_cli_rejects_unknown_settings():
