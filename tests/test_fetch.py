@@ -63,15 +63,11 @@ def test_bring_out_keeps_the_held_stick_clear_of_the_storage():
 
 @pytest.mark.slow
 @needs_weights
-@pytest.mark.xfail(
-    reason="weights/ur5e underestimates d at q_lift (-0.019 m vs coal +0.0175 m) and overestimates "
-    "inside the entrance: the last iterate collides by 3 mm (measured 2026-11-23)",
-    strict=False,
-)
 def test_bring_out_with_graphdistnet_keeps_the_stick_clear():
     (stage,) = run_fetch(0, collision="graphdistnet", stages=("bring_out",))
     assert stage.success, stage.detail
     assert stick_clearance(stage.scene, stage.q) > 0
+    assert gp.verify_path(stage.scene, stage.q)[0]
 
 
 @pytest.mark.slow
