@@ -296,11 +296,12 @@ Notes:
   certificate included). DiffCo is trained per problem on its own scene (coal labels, Fastron,
   then the fitted surrogate); that training is shown separately as (+… training).
 - The paper ran Adam only; its numbers are beside our Adam rows. Ipopt is our default solver.
-- Each solve's solver status is in the JSON beside this file. In the fetch setting the learned
-  models rate the grasp pose (fingers around the stick, 2 cm from it) below the margin, so
-  Ipopt stops with Infeasible_Problem_Detected; the path accepted is then its last iterate,
-  close to the coal-checked RRT-Connect seed, certified by coal like every other path (hence
-  the learned rows' higher path cost there).
+- Each solve's solver status is in the JSON beside this file. In the fetch setting a learned
+  model may rate the grasp pose (fingers around the stick, 2 cm from it) below the margin (DiffCo
+  on every problem, the GraphDistNet weights of 2026-11-30 04:20 on 2 of 20, the earlier ones on
+  most): Ipopt then stops with Infeasible_Problem_Detected or Restoration_Failed, and the path
+  accepted is its last iterate, close to the coal-checked RRT-Connect seed, certified by coal
+  like every other path (hence those rows' higher path cost).
 - There is no ClearanceNet for the fetch layouts: its fixed-size input encodes environments
   (a)–(e) only (the paper's fetch ClearanceNet is not described well enough to rebuild).
 """
@@ -341,7 +342,8 @@ def write(
     """Write ``out`` (markdown) and the runs and per-solve records beside it (JSON, same name).
 
     ``update``: keep the rows of the earlier run(s) at ``out`` that this run did not redo
-    (its (setting, method, solver) triples replace theirs). Returns the markdown.
+    (its (setting, method, solver) triples replace theirs); with no records, ``update`` only
+    re-renders the earlier runs. Returns the markdown.
     """
     redone = sorted({(r.setting, r.method, r.solver) for r in records})
     run = {
@@ -354,9 +356,9 @@ def write(
     }
     runs, kept = _previous(out) if update else ([], [])
     kept = [r for r in kept if (r.setting, r.method, r.solver) not in set(redone)]
-    runs, records = [*runs, run], kept + list(records)
-    order = {k: i for i, k in enumerate(SETTINGS)}
-    records.sort(key=lambda r: order.get(r.setting, len(order)))
+    runs, records = [*runs, run] if redone else runs, kept + list(records)
+    rank = {k: i for names in (SETTINGS, METHODS, SOLVERS) for i, k in enumerate(names)}
+    records.sort(key=lambda r: tuple(rank.get(k, 99) for k in (r.setting, r.method, r.solver)))
     header = ["# Table II reproduction: trajectory optimisation with each collision model", ""]
     for r in runs:
         rows = r["rows"] if isinstance(r["rows"], str) else ", ".join(r["rows"])

@@ -94,6 +94,9 @@ def test_update_keeps_the_rows_a_run_does_not_redo(tmp_path):
     saved = json.loads(out.with_suffix(".json").read_text())
     assert [r["command"] for r in saved["runs"]] == ["run 1", "run 2"]
     assert len(saved["records"]) == 2
+    before = out.read_text()
+    assert table2.write([], [], "", out, update=True) == before  # re-render only: no new run
+    assert len(json.loads(out.with_suffix(".json").read_text())["runs"]) == 2
     text = table2.write([redo], [], "run 3", out)  # without update: only this run's rows
     assert "adam" not in text.split("Notes:")[0] and "`run 1`" not in text
 
