@@ -5,13 +5,18 @@ Direct transcription over T waypoints Q = (q_0, …, q_{T−1}), q_0 = start, q_
     minimise    Σ_t ‖q_{t+1} − q_t‖²                                   (the paper's path cost)
     subject to  lower ≤ q_t ≤ upper,   |q_{t+1} − q_t| ≤ max_step      (joint, step limits)
                 d(p_k) ≥ margin           at the check points p = q_t + i/n_t (q_{t+1} − q_t),
-                                          i = 0 … n_t − 1, of every segment t (n_t = M + 1 first)
+                                          i = 0 … n_t − 1, of every segment t (n_t = M + 1 first),
+                                          except the fixed start and goal themselves
 
 with d the overall or per-link distance of any DistanceModel (one batched call through
-:class:`~gdnplan.casadi_bridge.DistanceCallback`). Continuous collision (the CCD certificate):
-after each solve, :func:`gdnplan.ccd.certify_path` checks the continuous motion with coal by
-conservative advancement; every waypoint segment it cannot certify gets twice as many check
-points (n_t ← 2 n_t) and Ipopt re-solves from the current path, for ``refine_rounds`` rounds.
+:class:`~gdnplan.casadi_bridge.DistanceCallback`). The start and goal rows would be constants:
+coal checks both when the problem is made, and a learned model that rates one of them below
+the margin (the held stick 1.75 cm above its shelf) would only make the NLP infeasible.
+Continuous collision (the CCD certificate): after each solve, :func:`gdnplan.ccd.certify_path`
+checks the continuous motion with coal by conservative advancement; every waypoint segment it
+cannot certify gets twice as many check points (n_t ← 2 n_t) — and, for a learned model, the
+margin is raised by the model's overestimate there — and Ipopt re-solves from the current path,
+for ``refine_rounds`` rounds.
 (The certificate as NLP rows, d(p_k) + d(p_{k+1}) ≥ δ(p_k, p_{k+1}) + 2·margin, was tried and
 dropped: at 3 check points per segment δ reaches ~1 m on seed paths, the rows are infeasible
 and Ipopt runs to its iteration cap.) Ipopt uses a limited-memory Hessian and starts from the
@@ -539,9 +544,11 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
     """Solve, certify, refine, re-solve: (q, last stats, certified).
 
     Each round that the coal certificate rejects doubles the check points of the rejected
-    segments and, for a learned model, raises the constraint margin by the model's observed
-    overestimate there (:func:`model_overestimate`): the learned constraint then keeps the
-    path away from the contact coal found, whatever the model's error.
+    segments and, for a learned model, raises the constraint margin of the whole path by the
+    model's observed overestimate there (:func:`model_overestimate`): the learned constraint
+    then keeps the path away from the contact coal found, whatever the model's error. (Raising
+    it on the rejected segments only was tried: on the (d) problems the contact then moved to
+    the neighbouring segments, and 2 of 6 problems needed a second seed, 3–5× slower.)
     """
     splits = np.full(problem.waypoints - 1, opts.interpolated + 1)
     per_link = supports_per_link(model) if opts.per_link is None else opts.per_link
@@ -634,7 +641,8 @@ class _Transcription:
         Q = casadi.vertcat(
             casadi.DM(problem.start).T, casadi.reshape(x, n, T - 2).T, casadi.DM(goal).T
         )  # (T, n)
-        W = casadi.sparsify(casadi.DM(_interpolation_matrix(splits)))  # (K, T)
+        inner = slice(1, -1)  # the fixed start and goal are no rows (module docstring)
+        W = casadi.sparsify(casadi.DM(_interpolation_matrix(splits)[inner]))  # (K, T)
         P = casadi.mtimes(W, Q)  # (K, n) check points along the path
         K = W.shape[0]
         self.callback = DistanceCallback(

@@ -108,15 +108,16 @@ def test_distance_bounds_relax_only_the_end_segments_a_learned_model_rates_too_c
 
 
 class GoalDip:
-    """A learned stand-in: coal's distance minus a 0.4 m dip at the goal (width 0.1 rad)."""
+    """A learned stand-in: coal's distance minus a dip of ``depth`` (m) at ``goal`` whose
+    width is √(w/2) rad (0.1 rad by default)."""
 
     name = "goal dip"
 
-    def __init__(self, goal):
-        self.goal = np.asarray(goal)
+    def __init__(self, goal, depth=0.4, w=0.02):
+        self.goal, self.depth, self.w = np.asarray(goal), depth, w
 
     def _dip(self, q):
-        return 0.4 * np.exp(-np.sum((q - self.goal) ** 2, axis=-1) / 0.02)
+        return self.depth * np.exp(-np.sum((q - self.goal) ** 2, axis=-1) / self.w)
 
     def distance(self, scene, q):
         return gp.signed_distance(scene, q) - self._dip(q)
@@ -124,7 +125,16 @@ class GoalDip:
     def distance_and_grad(self, scene, q):
         d, g = gp.signed_distance_and_grad(scene, q)
         dip = self._dip(q)
-        return d - dip, g + dip[:, None] * (q - self.goal) / 0.01
+        return d - dip, g + dip[:, None] * (q - self.goal) * 2 / self.w
+
+
+def test_ipopt_ignores_a_learned_misjudgement_of_the_fixed_start(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    model = GoalDip(START, depth=0.5, w=1e-4)  # rates the start itself 0.5 m too close
+    assert model.distance(square, np.array([START]))[0] < p.margin
+    result = plan(p, collision=model)
+    assert result.success, result.reason
+    assert result.status in ("Solve_Succeeded", "Solved_To_Acceptable_Level"), result.status
 
 
 def test_adam_stops_with_a_learned_model_rating_the_goal_below_the_margin(square):
