@@ -28,7 +28,9 @@ width 0.02–0.04 m). ``scene_seed`` is the fetch seed of the sample's layout. W
     q = clip(q_ref + ε, limits),  ε ~ N(0, σ² I),  log σ ~ U(log σ_min, log σ_max),
 
 q_ref drawn from the layout's configurations of that gripper state (open/closed: q_home,
-q_pregrasp, q_grasp; holding: q_grasp, q_lift, q_out), where uniform samples rarely fall, and
+q_pregrasp, q_grasp; holding: q_grasp, q_lift, q_out) or from the joint-space segments of the
+task through the entrance (open/closed: q_pregrasp → q_grasp; holding: q_lift → q_out, at a
+uniform fraction s: q_ref = q_a + s (q_b − q_a)), where uniform samples rarely fall, and
 (σ_min, σ_max) = NEAR_SIGMA: the log-uniform scale puts samples at every distance from the
 contacts, down to the millimetres of the stick resting on its shelf (at 0.005 rad the tcp moves
 ≈ 3 mm).
@@ -83,6 +85,11 @@ NEAR_REFS = {  # gripper state -> fetch configurations the near-contact samples 
     "open": ("q_home", "q_pregrasp", "q_grasp"),
     "closed": ("q_home", "q_pregrasp", "q_grasp"),
     "holding": ("q_grasp", "q_lift", "q_out"),
+}
+NEAR_SEGMENTS = {  # gripper state -> task segments (joint-space lines) through the entrance
+    "open": (("q_pregrasp", "q_grasp"),),
+    "closed": (("q_pregrasp", "q_grasp"),),
+    "holding": (("q_lift", "q_out"),),
 }
 
 
@@ -206,6 +213,17 @@ def ur5e_layout_seeds(seed: int) -> np.ndarray:
     return FETCH_SEED_BASE + seed * 10**6 + np.arange(UR5E_LAYOUTS, dtype=np.int64)
 
 
+def near_reference(rng: np.random.Generator, info: dict, gripper: str) -> np.ndarray:
+    """(3,) q_ref of a near-contact sample: one of the NEAR_REFS configurations or a point of a
+    NEAR_SEGMENTS segment, uniformly over the union of both lists (module docstring)."""
+    refs, segments = NEAR_REFS[gripper], NEAR_SEGMENTS[gripper]
+    k = int(rng.integers(len(refs) + len(segments)))
+    if k < len(refs):
+        return info[refs[k]]
+    a, b = (info[name] for name in segments[k - len(refs)])
+    return a + rng.uniform() * (b - a)
+
+
 def make_ur5e_shard(seed: int, start: int, n: int, near: float = 0.0) -> Dataset:
     """Samples ``start … start + n − 1`` of the ``ur5e`` split with ``seed``.
 
@@ -234,7 +252,7 @@ def make_ur5e_shard(seed: int, start: int, n: int, near: float = 0.0) -> Dataset
         scene = Scene(robot, obstacles, name="ur5e")
         q[i] = robot.sample(1, seed=[seed, start + i])[0]
         if is_near[i]:
-            ref = base.info[str(rng.choice(NEAR_REFS[GRIPPER_STATES[gripper[i]]]))]
+            ref = near_reference(rng, base.info, GRIPPER_STATES[gripper[i]])
             sigma = np.exp(rng.uniform(*np.log(NEAR_SIGMA)))
             q[i] = np.clip(ref + rng.normal(0.0, sigma, 3), robot.lower, robot.upper)
         di, gi = signed_distance_and_grad(scene, q[i][None])
