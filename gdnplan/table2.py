@@ -296,12 +296,12 @@ Notes:
   certificate included). DiffCo is trained per problem on its own scene (coal labels, Fastron,
   then the fitted surrogate); that training is shown separately as (+… training).
 - The paper ran Adam only; its numbers are beside our Adam rows. Ipopt is our default solver.
-- Each solve's solver status is in the JSON beside this file. In the fetch setting a learned
-  model may rate the grasp pose (fingers around the stick, 2 cm from it) below the margin (DiffCo
-  on every problem, the GraphDistNet weights of 2026-11-30 04:20 on 2 of 20, the earlier ones on
-  most): Ipopt then stops with Infeasible_Problem_Detected or Restoration_Failed, and the path
-  accepted is its last iterate, close to the coal-checked RRT-Connect seed, certified by coal
-  like every other path (hence those rows' higher path cost).
+- Each solve's solver status is in the JSON beside this file. Rows run before commit f634148
+  had constraint rows at the fixed goal: a learned model rating the grasp pose (fingers around
+  the stick, 2 cm from it) below the margin (DiffCo on every fetch problem) made Ipopt stop with
+  Infeasible_Problem_Detected, and the path accepted was its last iterate, close to the
+  coal-checked RRT-Connect seed, certified by coal like every other path (hence DiffCo's higher
+  path cost there). Since f634148 the fixed start and goal are no constraint rows.
 - There is no ClearanceNet for the fetch layouts: its fixed-size input encodes environments
   (a)–(e) only (the paper's fetch ClearanceNet is not described well enough to rebuild).
 """
@@ -342,8 +342,8 @@ def write(
     """Write ``out`` (markdown) and the runs and per-solve records beside it (JSON, same name).
 
     ``update``: keep the rows of the earlier run(s) at ``out`` that this run did not redo
-    (its (setting, method, solver) triples replace theirs); with no records, ``update`` only
-    re-renders the earlier runs. Returns the markdown.
+    (its (setting, method, solver) triples replace theirs; a run none of whose rows are left is
+    dropped from the header); with no records, ``update`` only re-renders. Returns the markdown.
     """
     redone = sorted({(r.setting, r.method, r.solver) for r in records})
     run = {
@@ -356,6 +356,10 @@ def write(
     }
     runs, kept = _previous(out) if update else ([], [])
     kept = [r for r in kept if (r.setting, r.method, r.solver) not in set(redone)]
+    left = {(r.setting, r.method, r.solver) for r in kept}
+    runs = [
+        r for r in runs if r["rows"] == "all" or any(tuple(x.split()) in left for x in r["rows"])
+    ]
     runs, records = [*runs, run] if redone else runs, kept + list(records)
     rank = {k: i for names in (SETTINGS, METHODS, SOLVERS) for i, k in enumerate(names)}
     records.sort(key=lambda r: tuple(rank.get(k, 99) for k in (r.setting, r.method, r.solver)))

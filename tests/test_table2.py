@@ -97,7 +97,9 @@ def test_update_keeps_the_rows_a_run_does_not_redo(tmp_path):
     before = out.read_text()
     assert table2.write([], [], "", out, update=True) == before  # re-render only: no new run
     assert len(json.loads(out.with_suffix(".json").read_text())["runs"]) == 2
-    text = table2.write([redo], [], "run 3", out)  # without update: only this run's rows
+    text = table2.write([replace(redo, time=6.0)], [], "run 3", out, update=True)
+    assert "`run 2`" not in text and "`run 1`" in text  # run 2's only row was redone
+    text = table2.write([redo], [], "run 4", out)  # without update: only this run's rows
     assert "adam" not in text.split("Notes:")[0] and "`run 1`" not in text
 
 
