@@ -336,6 +336,18 @@ def _previous(out: Path) -> tuple[list[dict], list[Record]]:
     return data["runs"], [Record(**r) for r in data["records"]]
 
 
+def _current_runs(runs: list[dict], keys: set[tuple[str, str, str]]) -> list[dict]:
+    """The runs (oldest first) that still own a row: a row belongs to the last run that made it
+    (``rows`` "all": every row of the table)."""
+    claimed, current = set(), []
+    for run in reversed(runs):
+        made = keys if run["rows"] == "all" else {tuple(x.split()) for x in run["rows"]}
+        if made - claimed:
+            current.append(run)
+        claimed |= made
+    return current[::-1]
+
+
 def write(
     records: list[Record], skipped: list[str], command: str, out: Path, update: bool = False
 ) -> str:
@@ -356,11 +368,8 @@ def write(
     }
     runs, kept = _previous(out) if update else ([], [])
     kept = [r for r in kept if (r.setting, r.method, r.solver) not in set(redone)]
-    left = {(r.setting, r.method, r.solver) for r in kept}
-    runs = [
-        r for r in runs if r["rows"] == "all" or any(tuple(x.split()) in left for x in r["rows"])
-    ]
     runs, records = [*runs, run] if redone else runs, kept + list(records)
+    runs = _current_runs(runs, {(r.setting, r.method, r.solver) for r in records})
     rank = {k: i for names in (SETTINGS, METHODS, SOLVERS) for i, k in enumerate(names)}
     records.sort(key=lambda r: tuple(rank.get(k, 99) for k in (r.setting, r.method, r.solver)))
     header = ["# Table II reproduction: trajectory optimisation with each collision model", ""]
