@@ -55,11 +55,11 @@ def test_compact_save_roundtrip(tmp_path):
     np.testing.assert_array_equal(back.d, ds.d)
 
 
-def test_bad_inputs_raise():
+def test_bad_inputs_raise(tmp_path):
     with pytest.raises(gp.UnknownNameError):
-        data.generate("z", 10, 0, "unused")
+        data.generate("z", 10, 0, tmp_path)
     with pytest.raises(gp.InputError):
-        data.generate("a", 0, 0, "unused")
+        data.generate("a", 0, 0, tmp_path)
     with pytest.raises(gp.InputError):
         data.load("/nonexistent/dir")
 
@@ -99,7 +99,7 @@ def test_ur5e_shards_roundtrip_with_their_robot_variants(tmp_path):
     assert sum(len(rows) for rows in back.variants().values()) == 6
 
 
-def test_ur5e_near_contact_samples_spread_around_the_task_configurations():
+def test_ur5e_near_contact_samples_spread_around_the_task_configurations(tmp_path):
     ds = data.make_shard("ur5e", seed=2, start=0, n=6, near=1.0)
     for i in range(len(ds)):
         scene = ds.scene(i)
@@ -109,4 +109,4 @@ def test_ur5e_near_contact_samples_spread_around_the_task_configurations():
         refs = [fetch.info[k] for k in ("q_home", "q_pregrasp", "q_grasp", "q_lift", "q_out")]
         assert min(np.abs(ds.q[i] - r).max() for r in refs) < 6 * max(data.NEAR_SIGMA)
     with pytest.raises(gp.InputError):
-        data.generate("d", 10, 0, "unused", near=0.5)
+        data.generate("d", 10, 0, tmp_path, near=0.5)
