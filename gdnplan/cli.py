@@ -394,7 +394,6 @@ def train_command(
         return
     if model != "graphdistnet":
         raise InputError(f"--model: expected graphdistnet or clearancenet, got {model!r}")
-    import torch
 
     from .data import DATA_DIR
     from .models.graphdistnet import GraphDistNetConfig
@@ -408,7 +407,7 @@ def train_command(
         raise InputError(f"--set: expected key=json_value, got {set_}") from e
     base = PRESETS[preset]().to_dict() if init is None else _card_config(init)
     config = GraphDistNetConfig.from_dict(base | overrides)
-    torch.set_num_threads(threads)
+    set_threads(threads)
     card = train(
         env,
         config,

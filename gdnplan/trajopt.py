@@ -605,17 +605,16 @@ def distance_bounds(
 
     margin everywhere — except that a learned model may rate a fixed endpoint q_e (start or
     goal) below the margin although coal certifies it (e.g. the fingers around the stick at
-    the grasp): then no path satisfies d̂ ≥ margin at q_e and Ipopt reports an infeasible
-    problem. The check points of the segment touching q_e are bounded instead by
+    the grasp): then no path satisfies d̂ ≥ margin at q_e. The check points of the segment
+    touching q_e are bounded instead by
 
         b_e = min(margin, d̂(q_e) − slack),
 
     which q_e itself satisfies; the coal certificate still judges the whole path. Used by the
-    Adam optimiser, whose stop test would otherwise never pass. Ipopt keeps the plain margin:
-    with these bounds it optimised the fetch reach-in to a path cost of 0.09 but took 47 s and
-    hugged the storage (coal clearance 0.4 mm), while with the plain margin it stops early
-    (Infeasible_Problem_Detected), and its last iterate, still near the coal-checked seed
-    path, is certified with 2 cm clearance in a few seconds.
+    Adam optimiser, whose stop test (over every check point, q_e included) would otherwise
+    never pass. Ipopt keeps the plain margin and has no rows at q_e (module docstring): with
+    these bounds it optimised the fetch reach-in to a path cost of 0.09 but took 47 s and
+    hugged the storage (coal clearance 0.4 mm).
     """
     bounds = np.full(int(np.sum(splits)) + 1, margin)
     if isinstance(model, CoalModel):
