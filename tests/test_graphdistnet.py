@@ -38,7 +38,9 @@ def random_model(env: str, dtype=torch.float32, **changes) -> tuple[gp.Scene, Gr
     return scene, GraphDistNetModel(GraphDistNet(config), dtype=dtype)
 
 
-@pytest.mark.parametrize("changes", [{}, {"activation": "silu", "max_edge": 0.25}])
+@pytest.mark.parametrize(
+    "changes", [{}, {"activation": "silu", "max_edge": 0.25}, {"two_way": False}]
+)
 def test_autograd_gradient_matches_finite_differences(changes):
     scene, model = random_model("e", torch.float64, **changes)
     q = scene.robot.sample(2, seed=2)
@@ -116,6 +118,8 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("fetch", "ur5e"),
     ("b", {"activation": "silu", "max_edge": 0.2}),
     ("d", {"mlp": ()}),
+    ("d", {"two_way": False}),  # obstacle features cached per scene
+    ("a", {"two_way": False, "activation": "silu"}),  # fewer obstacle nodes than candidates
 ]
 
 

@@ -22,6 +22,12 @@ h_k an MLP R^4 → R^{d_h} (k = 0), R^{2 d_h + 4} → R^{d_h} (k > 0). The cross
   leaving the candidate set does so with zero weight: d̂ is a deterministic, continuous
   function of the node positions (and piecewise smooth).
 
+One-way cross edges (``two_way=False``, beyond the paper): only robot nodes take a cross
+partner; obstacle nodes have z̄_i = z_i (no cross term), so x_o⁽ᵏ⁾, their scores and their
+readouts y_o⁽ᵏ⁾ depend on the scene alone. Inference computes them once per scene, and the
+work per configuration is the robot graph's (N_r of N = N_r + N_o nodes) plus its soft
+partners among the cached obstacle features.
+
 Readout (Eq. 9–11): per graph g ∈ {r, o} and layer k = 1 … K, α_i = softmax_{i∈g}(a⁽ᵏ⁾ᵀ x_i⁽ᵏ⁾),
 y_g⁽ᵏ⁾ = f(Σ_i α_i x_i⁽ᵏ⁾); y_g = max_k y_g⁽ᵏ⁾ element-wise; d̂ = scale · MLP(y_r ‖ y_o) (m).
 
@@ -42,6 +48,7 @@ import itertools
 import json
 import math
 import weakref
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
@@ -70,6 +77,9 @@ class GraphDistNetConfig:
         activation: ``"leaky_relu"`` (slope 0.2, the paper) or ``"silu"``.
         cross: ``"argmax"`` (paper: random, then argmax partner) or ``"soft_knn"``.
         cross_k: candidates k of ``soft_knn`` (k + 1 nearest nodes are looked at).
+        two_way: cross edges into both graphs (the paper). False: only robot nodes take a
+            cross partner (obstacle nodes have z̄_i = z_i), so the obstacle features depend on
+            the scene alone and inference computes them once per scene (module docstring).
         tau: initial temperature τ of ``soft_knn`` (normalised units², learned per layer).
         max_edge: densify graph edges longer than this (m), or None.
         grad_weight: weight λ of the gradient loss λ · (1 − cos(∂d̂/∂q, ∂f/∂q)).
@@ -87,6 +97,7 @@ class GraphDistNetConfig:
     activation: str = "leaky_relu"
     cross: str = "soft_knn"
     cross_k: int = 4
+    two_way: bool = True
     tau: float = 0.02
     max_edge: float | None = None
     grad_weight: float = 0.0
@@ -171,16 +182,24 @@ def nearest_candidates(d2: torch.Tensor, c: int) -> tuple[torch.Tensor, torch.Te
     c = min(c, max(d2.shape[1:]))
     out = []
     for dist, offset in ((d2, n_r), (d2.transpose(1, 2), 0)):
-        kk = min(c, dist.shape[-1])
-        near, idx = torch.topk(dist, kk, dim=-1, largest=False)  # ascending
-        log_phi = (near[..., -1:] - near).clamp_min(1e-12).log()
-        if kk < c:  # a small other graph: pad with zero-weight candidates
-            pad = (0, c - kk)
-            near = nn.functional.pad(near, pad, value=PAD_DIST2)
-            log_phi = nn.functional.pad(log_phi, pad, value=-math.inf)
-            idx = nn.functional.pad(idx, pad)
+        idx, log_phi, near = nearest_columns(dist, c)
         out.append((idx + offset, log_phi, near))
     return tuple(torch.cat(parts, 1) for parts in zip(*out, strict=True))
+
+
+def nearest_columns(dist: torch.Tensor, c: int) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Column indices (B, n, c), log φ (B, n, c) and values (B, n, c) of the c smallest entries of
+    every row of ``dist`` (B, n, m), ascending; padded with zero-weight (log φ = −∞) candidates
+    when m < c. φ_c = d²_c_max − d²_c as in :func:`nearest_candidates`."""
+    kk = min(c, dist.shape[-1])
+    near, idx = torch.topk(dist, kk, dim=-1, largest=False)  # ascending
+    log_phi = (near[..., -1:] - near).clamp_min(1e-12).log()
+    if kk < c:  # a small other graph: pad with zero-weight candidates
+        pad = (0, c - kk)
+        near = nn.functional.pad(near, pad, value=PAD_DIST2)
+        log_phi = nn.functional.pad(log_phi, pad, value=-math.inf)
+        idx = nn.functional.pad(idx, pad)
+    return idx, log_phi, near
 
 
 def _softmax_small(logits: torch.Tensor) -> torch.Tensor:
@@ -268,16 +287,36 @@ class Union:
 
 
 @dataclass(frozen=True)
+class ObstacleFeatures:
+    """What one-way cross edges (``two_way=False``) need of a scene's obstacle graph, per layer
+    k = 0 … K − 1; it depends on the scene alone.
+
+    Attributes:
+        v: (K, N_o, d_h) W_rel,k z_o⁽ᵏ⁾, the partner terms robot nodes mix at layer k.
+        score: (K, N_o) a⁽ᵏ⁾ᵀ x_o⁽ᵏ⁾ added to the partner logits of layer k (row 0: zeros).
+        readout: (K, d_h) the obstacle graph's readout y_o⁽ᵏ⁺¹⁾.
+    """
+
+    v: torch.Tensor
+    score: torch.Tensor
+    readout: torch.Tensor
+
+
+@dataclass(frozen=True)
 class SceneGraph:
     """The constants of one scene for :meth:`GraphDistNet.lean` (no padding).
 
     Attributes:
         obstacles: (N_o, 2) normalised obstacle node coordinates.
         ring: (2 N,) union index of prev(i) for every node i, then of next(i) (robot first).
+        robot_ring: (2 N_r,) the same for the robot graph alone.
+        fixed: the obstacle graph's features (``two_way=False``), else None.
     """
 
     obstacles: torch.Tensor
     ring: torch.Tensor
+    robot_ring: torch.Tensor
+    fixed: ObstacleFeatures | None = None
 
 
 class GraphDistNet(nn.Module):
@@ -362,7 +401,13 @@ class GraphDistNet(nn.Module):
         return idx, torch.softmax(logits, -1)
 
     def edge_preactivation(
-        self, k: int, z: torch.Tensor, nbr: torch.Tensor, idx: torch.Tensor, w: torch.Tensor
+        self,
+        k: int,
+        z: torch.Tensor,
+        nbr: torch.Tensor,
+        idx: torch.Tensor,
+        w: torch.Tensor,
+        one_way_from: int | None = None,
     ) -> torch.Tensor:
         """First linear layer of h_k on every edge, computed per node.
 
@@ -370,6 +415,8 @@ class GraphDistNet(nn.Module):
             z: (B, N, D) node inputs z_i.
             nbr: (B, N, 3) neighbours (prev, next, self).
             idx, w: (B, N, C) cross partners and weights.
+            one_way_from: nodes from this index on (the obstacles) take no cross term
+                (z̄_i = z_i, ``two_way=False``); None: every node takes one.
 
         Returns:
             (B, N, 3, H): W_loc (z_j − z_i) + W_rel (Σ_c w_ic z_c − z_i) + b.
@@ -382,6 +429,8 @@ class GraphDistNet(nn.Module):
         u_j = torch.gather(u, 1, nbr.flatten(1)[..., None].expand(-1, -1, h)).view(b, n, 3, h)
         v_c = torch.gather(v, 1, idx.flatten(1)[..., None].expand(-1, -1, h))
         v_bar = (w[:, :, None] @ v_c.view(b, n, -1, h)).squeeze(2)  # Σ_c w_ic v_c
+        if one_way_from is not None:
+            v_bar = torch.cat([v_bar[:, :one_way_from], v[:, one_way_from:]], 1)
         return u_j - u[:, :, None] + (v_bar - v + first.bias)[:, :, None]
 
     def readout(self, g: Union, h: torch.Tensor, k: int) -> torch.Tensor:
@@ -406,12 +455,13 @@ class GraphDistNet(nn.Module):
         """
         g = self.union(robot, obstacles)
         cand = self.candidates(g) if self.config.cross == "soft_knn" else None
+        one_way = None if self.config.two_way else g.n_robot
         h = None
         pooled = None
         for k in range(self.config.layers):
             z = g.x0 if h is None else torch.cat([g.x0, h], -1)
             idx, w = self.cross_weights(g, h, k, cand, generator)
-            pre = self.edge_preactivation(k, z, g.nbr, idx, w)
+            pre = self.edge_preactivation(k, z, g.nbr, idx, w, one_way)
             h = self.convs[k][1:](pre).sum(2) * g.mask[..., None]
             y = self.readout(g, h, k + 1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
@@ -419,14 +469,40 @@ class GraphDistNet(nn.Module):
 
     # ------------------------------------------------------------------ lean inference
     def scene_graph(self, robot: RobotGraph, obstacles: GraphBatch) -> SceneGraph:
-        """The :class:`SceneGraph` of a robot graph and one unpadded obstacle graph (1, N_o)."""
+        """The :class:`SceneGraph` of a robot graph and one unpadded obstacle graph (1, N_o).
+
+        With ``two_way=False`` it holds the obstacle features of the current weights.
+        """
         c = self.config
         xo = obstacles.nodes[0]
         xo = (xo - xo.new_tensor(c.origin)) / c.scale
         n_r = robot.n_nodes
-        prev = torch.cat([torch.as_tensor(robot.prev), obstacles.prev[0].cpu() + n_r])
-        next = torch.cat([torch.as_tensor(robot.next), obstacles.next[0].cpu() + n_r])
-        return SceneGraph(xo, torch.cat([prev, next]).to(xo.device))
+        robot_prev, robot_next = torch.as_tensor(robot.prev), torch.as_tensor(robot.next)
+        prev = torch.cat([robot_prev, obstacles.prev[0].cpu() + n_r])
+        next = torch.cat([robot_next, obstacles.next[0].cpu() + n_r])
+        obstacle_ring = torch.cat([obstacles.prev[0], obstacles.next[0]]).to(xo.device)
+        return SceneGraph(
+            xo,
+            torch.cat([prev, next]).to(xo.device),
+            torch.cat([robot_prev, robot_next]).to(xo.device),
+            None if c.two_way else self.obstacle_features(xo, obstacle_ring),
+        )
+
+    @torch.no_grad()
+    def obstacle_features(self, xo: torch.Tensor, ring: torch.Tensor) -> ObstacleFeatures:
+        """:class:`ObstacleFeatures` of normalised obstacle nodes (N_o, 2) with ring (2 N_o,):
+        the K layers run on the obstacle graph alone, every z̄_i = z_i."""
+        x0 = xo[None]
+        h = None
+        v, score, readout = [], [torch.zeros_like(xo[:, 0])], []
+        for k in range(self.config.layers):
+            z = x0 if h is None else torch.cat([x0, h], -1)
+            v.append((z @ self.convs[k][0].weight[:, z.shape[-1] :].T)[0])
+            h = self._lean_conv(k, z, lambda v_own: v_own, ring)
+            s = h @ self.attention[k]
+            score.append(s[0])
+            readout.append(self._lean_pool(h, s)[0])
+        return ObstacleFeatures(torch.stack(v), torch.stack(score[:-1]), torch.stack(readout))
 
     def lean(self, nodes: torch.Tensor, scene: SceneGraph) -> torch.Tensor:
         """d̂ (B,) (m) of robot nodes (B, N_r, 2) (m) among one scene's obstacles.
@@ -436,8 +512,10 @@ class GraphDistNet(nn.Module):
         cross terms Σ_c w_ic v_c are two dense products (:func:`_cross_mix`), a⁽ᵏ⁾ᵀ x⁽ᵏ⁾ is
         computed once for the readout and the next layer's partners, and the last linear layer
         (W, b) of h_k is applied once per node to the sum of the three edges' activations a_e:
-        Σ_e (W a_e + b) = W Σ_e a_e + 3 b.
+        Σ_e (W a_e + b) = W Σ_e a_e + 3 b. One-way networks run :meth:`lean_one_way`.
         """
+        if scene.fixed is not None:
+            return self.lean_one_way(nodes, scene)
         c = self.config
         b, n_r, _ = nodes.shape
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
@@ -452,9 +530,46 @@ class GraphDistNet(nn.Module):
             if score is not None:
                 logits = logits + score.flatten()[rows]
             z = x0 if h is None else torch.cat([x0, h], -1)
-            h = self._lean_conv(k, z, _cross_mix(idx, _softmax_small(logits), n_r), scene.ring)
+            m_ro, m_or = _cross_mix(idx, _softmax_small(logits), n_r)
+
+            def mix(v: torch.Tensor, m_ro=m_ro, m_or=m_or) -> torch.Tensor:
+                return torch.cat([m_ro @ v[:, n_r:], m_or @ v[:, :n_r]], 1)
+
+            h = self._lean_conv(k, z, mix, scene.ring)
             score = h @ self.attention[k]
-            y = self._lean_readout(h, score, n_r)
+            y = torch.cat(
+                [
+                    self._lean_pool(h[:, :n_r], score[:, :n_r]),
+                    self._lean_pool(h[:, n_r:], score[:, n_r:]),
+                ],
+                -1,
+            )
+            pooled = y if pooled is None else torch.maximum(pooled, y)
+        return self.head(pooled).squeeze(-1) * c.scale
+
+    def lean_one_way(self, nodes: torch.Tensor, scene: SceneGraph) -> torch.Tensor:
+        """:meth:`lean` for ``two_way=False``: only the robot graph runs per configuration;
+        partner terms, partner scores and the obstacle readout come from ``scene.fixed``."""
+        c, fixed = self.config, scene.fixed
+        b, n_o = nodes.shape[0], len(scene.obstacles)
+        xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
+        d2 = (xr[:, :, None] - scene.obstacles).square().sum(-1)  # (B, N_r, N_o)
+        idx, log_phi, near = nearest_columns(d2, min(c.cross_k + 1, n_o))
+        h, pooled = None, None
+        for k in range(c.layers):
+            logits = log_phi - near / self.log_tau[k].exp()
+            if k:
+                logits = logits + fixed.score[k].take(idx)
+            w = _softmax_small(logits)
+            m_ro = w.new_zeros(*idx.shape[:2], n_o).scatter_add(-1, idx, w)  # (B, N_r, N_o)
+
+            def mix(v: torch.Tensor, m_ro=m_ro, v_o=fixed.v[k]) -> torch.Tensor:
+                return m_ro @ v_o
+
+            z = xr if h is None else torch.cat([xr, h], -1)
+            h = self._lean_conv(k, z, mix, scene.robot_ring)
+            y_r = self._lean_pool(h, h @ self.attention[k])
+            y = torch.cat([y_r, fixed.readout[k].expand(b, -1)], -1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
         return self.head(pooled).squeeze(-1) * c.scale
 
@@ -462,13 +577,14 @@ class GraphDistNet(nn.Module):
         self,
         k: int,
         z: torch.Tensor,
-        mix: tuple[torch.Tensor, torch.Tensor],
+        mix: Callable[[torch.Tensor], torch.Tensor],
         ring: torch.Tensor,
     ) -> torch.Tensor:
         """x⁽ᵏ⁺¹⁾ (B, N, d_h): Σ of h_k over the edges (prev, next, self) of every node.
 
         Args:
-            z: (B, N, D) node inputs; mix: cross weights of :func:`_cross_mix`;
+            z: (B, N, D) node inputs.
+            mix: v (B, N, d_h) ↦ v̄ (B, N, d_h), v̄_i = Σ_c w_ic v_c (the cross terms).
             ring: (2 N,) prev and next indices.
         """
         first, rest = self.convs[k][0], self.convs[k][1:]
@@ -476,9 +592,7 @@ class GraphDistNet(nn.Module):
         u = z @ first.weight[:, :d].T  # (B, N, H)
         v = z @ first.weight[:, d:].T
         b, n, hd = v.shape
-        n_r = mix[0].shape[1]
-        v_bar = torch.cat([mix[0] @ v[:, n_r:], mix[1] @ v[:, :n_r]], 1)  # Σ_c w_ic v_c
-        c = v_bar - v + first.bias  # (B, N, H), pre-activation of the self edge
+        c = mix(v) - v + first.bias  # (B, N, H), pre-activation of the self edge
         if rest and self.config.activation == "leaky_relu":
             hidden = [m for m in rest[:-1] if isinstance(m, nn.Linear)]
             msg = _LeakyRingMessages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
@@ -491,13 +605,10 @@ class GraphDistNet(nn.Module):
         last = rest[-1]
         return nn.functional.linear(msg, last.weight, 3 * last.bias)
 
-    def _lean_readout(self, h: torch.Tensor, score: torch.Tensor, n_r: int) -> torch.Tensor:
-        """(B, 2 d_h): :meth:`readout` without padding, scores a⁽ᵏ⁾ᵀ x⁽ᵏ⁾ (B, N) given."""
-        ys = []
-        for sl in (slice(0, n_r), slice(n_r, None)):
-            alpha = torch.softmax(score[:, sl], -1)
-            ys.append(self.out_act((alpha[:, None] @ h[:, sl]).squeeze(1)))
-        return torch.cat(ys, -1)
+    def _lean_pool(self, h: torch.Tensor, score: torch.Tensor) -> torch.Tensor:
+        """(B, d_h): f(Σ_i α_i x_i), α = softmax(score) over the nodes of h (B, n, d_h)."""
+        alpha = torch.softmax(score, -1)
+        return self.out_act((alpha[:, None] @ h).squeeze(1))
 
 
 class GraphDistNetModel:
