@@ -1,10 +1,10 @@
 """GraphDistNet vs coal: seconds for a batch of configurations, measured side by side in one run.
 
 Usage: python benchmarks/inference.py [--n 5000] [--repeats 3] [--envs a b c d e fetch]
-[--threads 1]
+[--threads 1] [--weights weights/]
 
-For each scene with shipped weights (``weights/<env>.safetensors``; the UR5e ``fetch`` scene
-uses ``weights/ur5e.safetensors``), on one scene (seed 0) and the same n uniformly random
+For each scene with weights (``<weights>/<env>.safetensors``, shipped ones by default; the UR5e
+``fetch`` scene uses ``ur5e.safetensors``), on one scene (seed 0) and the same n uniformly random
 configurations: coal distance and distance + exact gradient (bounding-circle broad phase,
 batches split over all cores by processes) and GraphDistNet distance and distance + ∂d̂/∂q
 (float32, ``--threads`` torch threads), best of the repeats, after one warm-up call each. Also
@@ -65,9 +65,9 @@ def machine() -> str:
     return f"{name}, {os.cpu_count()} cores, torch {torch.__version__}"
 
 
-def row(env: str, n: int, repeats: int, peak: float) -> str:
+def row(env: str, n: int, repeats: int, peak: float, weights: Path = WEIGHTS) -> str:
     """One table row: seconds of coal and GraphDistNet for n configurations of scene ``env``."""
-    path = WEIGHTS / f"{WEIGHTS_FOR_SCENE.get(env, env)}.safetensors"
+    path = weights / f"{WEIGHTS_FOR_SCENE.get(env, env)}.safetensors"
     if not path.exists():
         return f"| {env} | (no weights at {path.name}) ||||||"
     scene = gp.make_scene(env, seed=0)
@@ -96,11 +96,13 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--envs", nargs="+", default=["a", "b", "c", "d", "e", "fetch"])
     parser.add_argument("--threads", type=int, default=1, help="torch intra-op threads")
+    parser.add_argument("--weights", type=Path, default=WEIGHTS, help="weights directory")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     peak = matmul_gflops()
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
     print(f"machine: {machine()}; torch threads {args.threads}; n = {args.n}; {now}")
+    print(f"weights: {args.weights}")
     print(f"load average at start: {os.getloadavg()}")
     print(f"float32 matmul peak ({args.threads} threads): {peak:.1f} GFLOP/s")
     print(
@@ -109,7 +111,7 @@ def main() -> None:
     )
     print("|---|---|---|---|---|---|---|---|")
     for env in args.envs:
-        print(row(env, args.n, args.repeats, peak), flush=True)
+        print(row(env, args.n, args.repeats, peak, args.weights), flush=True)
     print(f"load average at end: {os.getloadavg()}")
 
 

@@ -5,10 +5,13 @@ import pytest
 
 import gdnplan as gp
 from gdnplan.ccd import certify_path, lever_arms, motion_bound, verify_path
+from gdnplan.models import CoalModel
 from gdnplan.trajopt import (
     Plan,
     Problem,
     TrajoptOptions,
+    _path_parameters,
+    _Transcription,
     distance_bounds,
     plan,
     straight_line,
@@ -38,6 +41,27 @@ def test_ipopt_solves_planar2_around_a_square_with_coal(square):
     np.testing.assert_allclose(result.q[[0, -1]], [START, GOAL])
     ok, dmin = verify_path(square, result.q)
     assert ok and dmin > 0 and result.min_distance == pytest.approx(dmin)
+
+
+def test_refine_round_warm_start_keeps_the_multipliers_of_kept_check_points(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=6)
+    splits, refined = np.array([2, 2, 2, 2, 2]), np.array([2, 4, 2, 2, 2])
+    np.testing.assert_array_equal(_path_parameters(splits)[:4], [0, 0.5, 1, 1.5])
+    opts = TrajoptOptions(per_link=False)
+    nlp = _Transcription(p, CoalModel(), np.array(GOAL), opts, splits, p.margin)
+    q, _ = nlp.solve(straight_line(np.array(START), np.array(GOAL), 6))
+    lam_g, lam_x = nlp.duals_on(refined)
+    warm = _Transcription(p, CoalModel(), np.array(GOAL), opts, refined, p.margin, warm=True)
+    assert lam_g.shape == warm.lbg.shape and lam_x.shape == warm.lbx.shape
+    old_g = nlp.duals[0]
+    # inner check points: old 1 … 9 at s = 0.5 … 4.5; new: 0.5, 1, 1.25, 1.5, 1.75, 2, …
+    np.testing.assert_array_equal(lam_g[:2], old_g[:2])  # s = 0.5, 1
+    assert lam_g[2] == 0 and lam_g[4] == 0  # s = 1.25, 1.75: new
+    np.testing.assert_array_equal(lam_g[[3, 5]], old_g[[2, 3]])  # s = 1.5, 2
+    np.testing.assert_array_equal(lam_g[11:], old_g[9:])  # step rows
+    assert np.abs(old_g).max() > 0  # the straight line hits the square: active rows
+    _, stats = warm.solve(q, (lam_g, lam_x))
+    assert stats["return_status"] in ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
 
 def test_certified_check_rejects_a_path_clipping_a_corner(square):

@@ -615,8 +615,8 @@ class GraphDistNetModel:
     """A trained GraphDistNet as a :class:`~gdnplan.models.DistanceModel`.
 
     q → node positions (:meth:`~gdnplan.graph.RobotGraph.kinematics`, float64) → d̂ in
-    ``dtype`` (float32 by default) in chunks of ``chunk`` samples → ∂d̂/∂p_n by autograd on the
-    robot node coordinates p_n (B, N, 2) → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
+    ``dtype`` (float32 by default) in equal chunks of at most ``chunk`` samples → ∂d̂/∂p_n by
+    autograd on the robot node coordinates p_n (B, N, 2) → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
     (:meth:`~gdnplan.graph.RobotGraph.pullback`, float64). ``cross="soft_knn"`` networks run
     :meth:`GraphDistNet.lean`, others the reference :meth:`GraphDistNet.forward`. The graphs of
     a scene are built once per scene object (scenes are immutable) and cached. Results are
@@ -629,7 +629,7 @@ class GraphDistNetModel:
         self,
         net: GraphDistNet,
         card: dict | None = None,
-        chunk: int = 64,
+        chunk: int = 80,
         dtype: torch.dtype = torch.float32,
         device: str | torch.device = "cpu",
     ):
@@ -665,6 +665,12 @@ class GraphDistNetModel:
         robot = graphs.robot.batch(nodes, device=self.device, dtype=self.dtype)
         return self.net(robot, _repeat(graphs.obstacles, len(nodes)), gen)
 
+    def _chunks(self, n: int) -> list[slice]:
+        """n samples in ⌈n / chunk⌉ near-equal slices (77 → one, not 64 + 13: the fixed cost
+        per pass matters at the planner's batch sizes)."""
+        edges = np.linspace(0, n, -(-n // self.chunk) + 1).round().astype(int)
+        return [slice(a, b) for a, b in itertools.pairwise(edges)]
+
     def _generator(self) -> torch.Generator | None:
         return torch.Generator().manual_seed(0) if self.config.cross == "argmax" else None
 
@@ -678,10 +684,8 @@ class GraphDistNetModel:
         gen = self._generator()
         with torch.inference_mode():
             out = [
-                self._estimate(
-                    graphs, self._tensor(graphs.robot.positions(q[s : s + self.chunk])), gen
-                )
-                for s in range(0, len(q), self.chunk)
+                self._estimate(graphs, self._tensor(graphs.robot.positions(q[part])), gen)
+                for part in self._chunks(len(q))
             ]
             return torch.cat(out).double().cpu().numpy()
 
@@ -691,8 +695,8 @@ class GraphDistNetModel:
         graphs = self._graphs(scene)
         gen = self._generator()
         ds, gs = [], []
-        for s in range(0, len(q), self.chunk):
-            nodes, joints = graphs.robot.kinematics(q[s : s + self.chunk])
+        for part in self._chunks(len(q)):
+            nodes, joints = graphs.robot.kinematics(q[part])
             x = self._tensor(nodes).requires_grad_(True)
             with torch.enable_grad():
                 d = self._estimate(graphs, x, gen)
