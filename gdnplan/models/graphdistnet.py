@@ -63,6 +63,9 @@ from ..scene import Scene
 
 PAD_DIST2 = 1e6  # squared distance (normalised units²) given to padded candidates
 LEAKY_SLOPE = 0.2  # negative slope of the paper's LeakyReLU
+# graph nodes per inference pass: (d) two-way 80 configurations × 108 nodes, one-way 320 × 28
+# were the fastest chunks on the 2-core Xeon (benchmarks/RESULTS.md)
+CHUNK_NODES = 9000
 
 
 @dataclass(frozen=True)
@@ -624,7 +627,9 @@ class GraphDistNetModel:
     """A trained GraphDistNet as a :class:`~gdnplan.models.DistanceModel`.
 
     q → node positions (:meth:`~gdnplan.graph.RobotGraph.kinematics`, float64) → d̂ in
-    ``dtype`` (float32 by default) in equal chunks of at most ``chunk`` samples → ∂d̂/∂p_n by
+    ``dtype`` (float32 by default) in equal chunks of at most ``chunk`` samples (default: about
+    ``CHUNK_NODES`` graph nodes per pass, the nodes a configuration runs being N_r + N_o, or N_r
+    for one-way networks) → ∂d̂/∂p_n by
     autograd on the robot node coordinates p_n (B, N, 2) → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
     (:meth:`~gdnplan.graph.RobotGraph.pullback`, float64). ``cross="soft_knn"`` networks run
     :meth:`GraphDistNet.lean`, others the reference :meth:`GraphDistNet.forward`. The graphs of
@@ -638,7 +643,7 @@ class GraphDistNetModel:
         self,
         net: GraphDistNet,
         card: dict | None = None,
-        chunk: int = 80,
+        chunk: int | None = None,
         dtype: torch.dtype = torch.float32,
         device: str | torch.device = "cpu",
     ):
@@ -674,10 +679,16 @@ class GraphDistNetModel:
         robot = graphs.robot.batch(nodes, device=self.device, dtype=self.dtype)
         return self.net(robot, _repeat(graphs.obstacles, len(nodes)), gen)
 
-    def _chunks(self, n: int) -> list[slice]:
+    def _chunks(self, n: int, graphs: _SceneCache) -> list[slice]:
         """n samples in ⌈n / chunk⌉ near-equal slices (77 → one, not 64 + 13: the fixed cost
         per pass matters at the planner's batch sizes)."""
-        edges = np.linspace(0, n, -(-n // self.chunk) + 1).round().astype(int)
+        chunk = self.chunk
+        if chunk is None:
+            lean = graphs.lean
+            one_way = lean is not None and lean.fixed is not None
+            nodes = graphs.robot.n_nodes + (0 if one_way else graphs.obstacles.nodes.shape[1])
+            chunk = max(16, CHUNK_NODES // nodes)
+        edges = np.linspace(0, n, -(-n // chunk) + 1).round().astype(int)
         return [slice(a, b) for a, b in itertools.pairwise(edges)]
 
     def _generator(self) -> torch.Generator | None:
@@ -694,7 +705,7 @@ class GraphDistNetModel:
         with torch.inference_mode():
             out = [
                 self._estimate(graphs, self._tensor(graphs.robot.positions(q[part])), gen)
-                for part in self._chunks(len(q))
+                for part in self._chunks(len(q), graphs)
             ]
             return torch.cat(out).double().cpu().numpy()
 
@@ -704,7 +715,7 @@ class GraphDistNetModel:
         graphs = self._graphs(scene)
         gen = self._generator()
         ds, gs = [], []
-        for part in self._chunks(len(q)):
+        for part in self._chunks(len(q), graphs):
             nodes, joints = graphs.robot.kinematics(q[part])
             x = self._tensor(nodes).requires_grad_(True)
             with torch.enable_grad():
