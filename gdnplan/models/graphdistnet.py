@@ -599,7 +599,7 @@ class GraphDistNet(nn.Module):
             mix: v (B, N, d_h) ↦ v̄ (B, N, d_h), v̄_i = Σ_c w_ic v_c (the cross terms).
             ring: (2 N,) prev and next indices.
         """
-        first, rest = self.convs[k][0], self.convs[k][1:]
+        first, *rest = self.convs[k]  # a list: slicing the Sequential would build a new one
         d = z.shape[-1]
         u = z @ first.weight[:, :d].T  # (B, N, H)
         v = z @ first.weight[:, d:].T
@@ -613,7 +613,9 @@ class GraphDistNet(nn.Module):
             pre = torch.cat([ring_edges, c[:, None]], 1)  # (B, 3, N, H)
             if not rest:
                 return pre.sum(1)
-            msg = rest[:-1](pre).sum(1)
+            for module in rest[:-1]:
+                pre = module(pre)
+            msg = pre.sum(1)
         last = rest[-1]
         return nn.functional.linear(msg, last.weight, 3 * last.bias)
 
