@@ -631,8 +631,8 @@ class GraphDistNetModel:
     q → node positions (:meth:`~gdnplan.graph.RobotGraph.kinematics`, float64) → d̂ in
     ``dtype`` (float32 by default) in equal chunks of at most ``chunk`` samples (default: about
     ``CHUNK_NODES`` graph nodes per pass, the nodes a configuration runs being N_r + N_o, or N_r
-    for one-way networks) → ∂d̂/∂p_n by
-    autograd on the robot node coordinates p_n (B, N, 2) → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
+    for one-way networks) → ∂d̂/∂p_n by autograd on the robot node coordinates p_n (B, N, 2)
+    → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
     (:meth:`~gdnplan.graph.RobotGraph.pullback`, float64). ``cross="soft_knn"`` networks run
     :meth:`GraphDistNet.lean`, others the reference :meth:`GraphDistNet.forward`. The graphs of
     a scene are built once per scene object (scenes are immutable) and cached. Results are
