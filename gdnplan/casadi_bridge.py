@@ -9,7 +9,10 @@ its own configuration, so
 
 and one batched ``distance_and_grad`` call yields both the values and the Jacobian. The last
 (x, y, ∂y/∂x) is cached: Ipopt asks for the value and the Jacobian at the same point, which then
-costs one model pass. Build the NLP with MX symbols (SX would call the callback per nonzero).
+costs one model pass. A model with ``distance_deferred_grad`` (GraphDistNet) computes the
+Jacobian only when Ipopt asks for it: the line search's rejected trial points — about 40 % of
+the evaluations on the (d) problems — then cost a forward pass alone. Build the NLP with MX
+symbols (SX would call the callback per nonzero).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from .errors import InputError
 from .models import CoalModel, DistanceModel
 from .scene import Scene
 
-BatchFn = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+BatchFn = Callable[[np.ndarray], tuple[np.ndarray, Callable[[], np.ndarray]]]
 
 
 def supports_per_link(model: DistanceModel) -> bool:
@@ -42,42 +45,57 @@ def supports_per_link(model: DistanceModel) -> bool:
 def distance_rows(
     model: DistanceModel, scene: Scene, per_link: bool = False, cap: float = np.inf
 ) -> tuple[BatchFn, int]:
-    """The batched function q (B, dof) -> (d (B, R), ∂d/∂q (B, R, dof)) and its row count R.
+    """The batched function q (B, dof) -> (d (B, R), a function returning ∂d/∂q (B, R, dof))
+    and its row count R.
 
-    With ``per_link`` there is one row per link polygon; distances above ``cap`` (m) report
-    ``cap`` with a zero gradient (an inactive constraint; coal skips those pairs entirely).
-    Raises InputError when the model has no per-link distances.
+    The gradient is computed when that function is called if the model has
+    ``distance_deferred_grad``, else together with d. With ``per_link`` there is one row per
+    link polygon; distances above ``cap`` (m) report ``cap`` with a zero gradient (an inactive
+    constraint; coal skips those pairs entirely). Raises InputError when the model has no
+    per-link distances.
     """
     if per_link and not supports_per_link(model):
         raise InputError(f"per_link: model {model.name!r} has no per-link distances")
     if not per_link:
+        deferred = getattr(model, "distance_deferred_grad", None)
 
-        def overall(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        def overall(q: np.ndarray) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
+            if deferred is not None:
+                d, grad = deferred(scene, q)
+                return np.asarray(d, float)[:, None], lambda: np.asarray(grad(), float)[:, None]
             d, g = model.distance_and_grad(scene, q)
-            return np.asarray(d, float)[:, None], np.asarray(g, float)[:, None, :]
+            return np.asarray(d, float)[:, None], _given(np.asarray(g, float)[:, None, :])
 
         return overall, 1
     if isinstance(model, CoalModel):
 
-        def coal_links(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        def coal_links(q: np.ndarray) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
             w = checker(scene).closest(q, per_link=True, cap=cap)
-            return w.distance, witness_gradient(scene, q, w)
+            return w.distance, _given(witness_gradient(scene, q, w))
 
         return coal_links, scene.robot.n_links
 
-    def links(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def links(q: np.ndarray) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
         d, g = model.distance_and_grad(scene, q, per_link=True)
-        return np.minimum(np.asarray(d, float), cap), np.asarray(g, float) * (d < cap)[..., None]
+        d = np.asarray(d, float)
+        return np.minimum(d, cap), _given(np.asarray(g, float) * (d < cap)[..., None])
 
     return links, scene.robot.n_links
 
 
+def _given(g: np.ndarray) -> Callable[[], np.ndarray]:
+    """A gradient already computed, as the function :func:`distance_rows` returns."""
+    return lambda: g
+
+
 @dataclass
 class _Cache:
-    """Last evaluated point and its values (K·R,) and Jacobian nonzeros (CCS order)."""
+    """Last evaluated point x, its values (K·R,), the function giving ∂d/∂q (K, R, dof) and,
+    once asked for, the Jacobian nonzeros (CCS order)."""
 
     x: np.ndarray | None = None
     y: np.ndarray | None = None
+    grad: Callable[[], np.ndarray] | None = None
     nz: np.ndarray | None = None
 
 
@@ -93,7 +111,8 @@ class DistanceCallback(casadi.Callback):
         n_points: K, configurations per call.
         dof: joints per configuration.
         rows: R, distances per configuration.
-        model_calls: batched ``distance_and_grad`` calls so far.
+        model_calls: batched model calls so far (one per new x).
+        gradient_calls: of these, the calls whose Jacobian was asked for.
     """
 
     def __init__(
@@ -109,6 +128,7 @@ class DistanceCallback(casadi.Callback):
         self.n_points, self.dof = int(n_points), scene.robot.dof
         self.fn, self.rows = distance_rows(model, scene, per_link, cap)
         self.model_calls = 0
+        self.gradient_calls = 0
         self._cache = _Cache()
         self._jac: _JacobianCallback | None = None  # kept alive: CasADi holds no reference
         self.construct(name, {"enable_fd": False})
@@ -133,8 +153,8 @@ class DistanceCallback(casadi.Callback):
         return block_sparsity(self.n_points, self.rows, self.dof)
 
     # ------------------------------------------------------------ evaluation
-    def evaluate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Values (K·R,) and Jacobian nonzeros (K·dof·R,) at x, from the cache when x repeats."""
+    def values(self, x: np.ndarray) -> np.ndarray:
+        """Distances (K·R,) at x (K·dof,): one model call per new x, from the cache otherwise."""
         x = np.asarray(x, float).ravel()
         if x.size != self.n_points * self.dof:
             raise InputError(
@@ -143,15 +163,26 @@ class DistanceCallback(casadi.Callback):
             )
         c = self._cache
         if c.x is None or not np.array_equal(c.x, x):
-            d, g = self.fn(x.reshape(self.n_points, self.dof))
+            d, grad = self.fn(x.reshape(self.n_points, self.dof))
             self.model_calls += 1
-            # CCS order: column (k, j), then row r within block k
-            self._cache = c = _Cache(x.copy(), d.ravel(), np.swapaxes(g, 1, 2).ravel())
-        return c.y, c.nz
+            self._cache = c = _Cache(x.copy(), d.ravel(), grad)
+        return c.y
+
+    def jacobian_nonzeros(self, x: np.ndarray) -> np.ndarray:
+        """Nonzeros (K·dof·R,) of ∂y/∂x at x in CCS order (column (k, j), then row r)."""
+        self.values(x)
+        c = self._cache
+        if c.nz is None:
+            c.nz = np.swapaxes(c.grad(), 1, 2).ravel()
+            self.gradient_calls += 1
+        return c.nz
+
+    def evaluate(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Values (K·R,) and Jacobian nonzeros (K·dof·R,) at x, from the cache when x repeats."""
+        return self.values(x), self.jacobian_nonzeros(x)
 
     def eval(self, arg):
-        y, _ = self.evaluate(np.asarray(arg[0]))
-        return [casadi.DM(y)]
+        return [casadi.DM(self.values(np.asarray(arg[0])))]
 
     def has_jacobian(self) -> bool:
         return True
@@ -184,7 +215,7 @@ class _JacobianCallback(casadi.Callback):
         return self.sparsity
 
     def eval(self, arg):
-        _, nz = self.parent.evaluate(np.asarray(arg[0]))
+        nz = self.parent.jacobian_nonzeros(np.asarray(arg[0]))
         return [casadi.DM(self.sparsity, nz)]
 
 

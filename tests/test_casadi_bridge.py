@@ -95,6 +95,19 @@ def test_graphdistnet_callback_jacobian_equals_finite_differences():
     np.testing.assert_allclose(J, fd, atol=0.05)
 
 
+@pytest.mark.skipif(not WEIGHTS_A.exists(), reason="no GraphDistNet weights for env a")
+def test_values_alone_skip_the_backward_pass_of_a_deferred_model():
+    scene = gp.make_scene("a")
+    cb = DistanceCallback("d", gp.load_model(WEIGHTS_A), scene, 3)
+    f, jac = _functions(cb, 6)
+    x = scene.robot.sample(3, seed=0).ravel()
+    f(x)  # a line-search trial point: the value only
+    f(x + 0.01)
+    assert (cb.model_calls, cb.gradient_calls) == (2, 0)
+    jac(x + 0.01)  # accepted: the Jacobian at the cached point costs the backward pass only
+    assert (cb.model_calls, cb.gradient_calls) == (2, 1)
+
+
 def test_per_link_on_a_model_without_it_raises():
     scene = gp.make_scene("a")
     with pytest.raises(gp.InputError, match="per_link"):

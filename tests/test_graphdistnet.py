@@ -69,6 +69,18 @@ def test_batch_equals_per_sample_and_is_deterministic():
     np.testing.assert_array_equal(g1, g2)
 
 
+@pytest.mark.parametrize("changes", [{}, {"two_way": False}])
+def test_deferred_gradient_equals_distance_and_grad(changes):
+    scene, model = random_model("d", **changes)
+    model.chunk = 4  # several chunks, each holding its graph until the gradient is asked for
+    q = scene.robot.sample(10, seed=6)
+    d, grad = model.distance_deferred_grad(scene, q)
+    d_ref, g_ref = model.distance_and_grad(scene, q)
+    np.testing.assert_array_equal(d, d_ref)
+    np.testing.assert_allclose(grad(), g_ref, rtol=1e-6, atol=1e-7)
+    np.testing.assert_array_equal(grad(), grad())  # asked twice: the same array, one backward
+
+
 def test_permuting_obstacles_and_start_vertices_keeps_distance():
     scene, model = random_model("e")
     q = scene.robot.sample(5, seed=4)
