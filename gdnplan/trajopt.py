@@ -332,6 +332,8 @@ class TrajoptOptions:
         rrt_step: RRT-Connect extension (rad, joint-space 2-norm); long steps were fastest on
             environment (d), narrow passages (fetch) may need ~0.3.
         link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
+        ipopt: extra Ipopt options (name → value) over the defaults, e.g.
+            ``{"limited_memory_initialization": "scalar1"}`` (Ipopt's own default).
         adam_iterations, adam_lr, adam_c, adam_eps, adam_stop: the paper's Adam optimiser:
             iteration cap, step size (rad), cost constant c, ε, and the stop clearance (m).
     """
@@ -351,6 +353,7 @@ class TrajoptOptions:
     rrt_time: float = 5.0
     rrt_step: float = 2.0
     link_cap: float = 0.3
+    ipopt: dict = field(default_factory=dict)
     adam_iterations: int = 500
     adam_lr: float = 0.05
     adam_c: float = 1e-3
@@ -707,6 +710,7 @@ class _Transcription:
             "mu_strategy": "adaptive",
             "sb": "yes",  # no banner: stdout stays clean for --json
         }
+        ipopt.update(opts.ipopt)
         if warm:  # a refine round: start from the last round's primal-dual point
             ipopt.update(WARM_START_OPTIONS)
         self.solver = casadi.nlpsol(

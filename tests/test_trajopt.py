@@ -43,6 +43,13 @@ def test_ipopt_solves_planar2_around_a_square_with_coal(square):
     assert ok and dmin > 0 and result.min_distance == pytest.approx(dmin)
 
 
+def test_extra_ipopt_options_reach_the_solver(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    opts = TrajoptOptions(ccd=False, starts=1, ipopt={"max_iter": 2})
+    result = plan(p, collision="coal", options=opts)
+    assert result.iterations == 2 and result.status == "Maximum_Iterations_Exceeded"
+
+
 def test_refine_round_warm_start_keeps_the_multipliers_of_kept_check_points(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=6)
     splits, refined = np.array([2, 2, 2, 2, 2]), np.array([2, 4, 2, 2, 2])
