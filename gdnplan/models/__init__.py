@@ -20,7 +20,12 @@ from ..scene import Scene
 
 @runtime_checkable
 class DistanceModel(Protocol):
-    """What every collision-distance model provides."""
+    """What every collision-distance model provides.
+
+    Optional: ``distance_deferred_grad(scene, q) -> (d (B,), grad)``, where ``grad()`` returns
+    ∂d/∂q (B, dof) when called (GraphDistNet). The CasADi bridge then skips the gradient of
+    points whose Jacobian the solver never asks for.
+    """
 
     name: str
 
