@@ -44,6 +44,7 @@ prove it equal to :meth:`GraphDistNet.forward` (values and gradients).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import json
 import math
@@ -737,13 +738,10 @@ class GraphDistNetModel:
         graphs = self._graphs(scene)
         gen = self._generator()
         tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
-        grad: list[np.ndarray] = []
 
+        @functools.cache
         def gradient() -> np.ndarray:
-            if not grad:
-                grad.append(np.concatenate([t.grad(graphs.robot) for t in tapes]))
-                tapes.clear()  # the graphs are freed by the backward pass
-            return grad[0]
+            return np.concatenate([t.grad(graphs.robot) for t in tapes])
 
         return torch.cat([t.d.detach() for t in tapes]).double().cpu().numpy(), gradient
 
