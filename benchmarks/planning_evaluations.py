@@ -3,8 +3,9 @@
 Plans the 20 (d) reaching problems of ``gdnplan.table2.reaching_problems("d")`` with Ipopt
 and one collision model, and prints per problem: certified or not, wall time (s), batched
 constraint evaluations (model passes), Ipopt iterations and path cost (rad²), then the medians.
-Evaluation and iteration counts are deterministic (one torch thread), so solver settings can be
-compared on a busy machine by counts; compare times only within one run.
+Evaluation and iteration counts are deterministic for a given ``--threads`` (torch threads,
+default 1; a different count changes the float32 sums and so Ipopt's path), so solver settings
+can be compared on a busy machine by counts; compare times only within one run.
 
     .venv/bin/python benchmarks/planning_evaluations.py --model GraphDistNet
     .venv/bin/python benchmarks/planning_evaluations.py --model coal \
@@ -45,8 +46,9 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=20)
     parser.add_argument("--ipopt", nargs="*", default=[], metavar="NAME=VALUE")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE")
+    parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args()
-    torch.set_num_threads(1)
+    torch.set_num_threads(args.threads)
     opts = replace(TrajoptOptions(ipopt=_pairs(args.ipopt)), **_pairs(args.set))
     model = "coal" if args.model == "coal" else gp.load_model(WEIGHTS_DIR / "d.safetensors")
     problems = reaching_problems("d")[: args.n]
@@ -66,7 +68,8 @@ def main() -> None:
     print(
         f"\n{args.model}: {ok.sum()}/{len(ok)} certified, median time {np.median(t):.2f} s, "
         f"median evaluations {np.median(calls):.1f}, median iterations {np.median(iters):.1f}, "
-        f"mean path cost {cost.mean():.3f} rad² (options: ipopt={opts.ipopt}, set={args.set})"
+        f"mean path cost {cost.mean():.3f} rad² (options: ipopt={opts.ipopt}, set={args.set}, "
+        f"threads={args.threads})"
     )
 
 

@@ -13,7 +13,10 @@ from gdnplan.models.graphdistnet import (
     GraphDistNet,
     GraphDistNetConfig,
     GraphDistNetModel,
+    _pairwise_d2,
     _repeat,
+    nearest_columns,
+    nearest_obstacle_nodes,
 )
 from gdnplan.train import distance_loss, evaluate
 
@@ -109,6 +112,22 @@ def test_lean_first_layer_equals_naive_per_edge_reference():
         feat = torch.cat([z_j - z[:, :, None], (z_bar - z)[:, :, None].expand(-1, -1, 3, -1)], -1)
         naive = net.convs[k][0](feat)
         torch.testing.assert_close(lean, naive, atol=1e-5, rtol=1e-5)
+
+
+def test_sparse_nearest_nodes_equal_dense_selection_and_gradient():
+    gen = torch.Generator().manual_seed(0)
+    xr = torch.rand(6, 9, 2, generator=gen, dtype=torch.float64, requires_grad=True)
+    xo = torch.rand(30, 2, generator=gen, dtype=torch.float64)
+    weights = torch.rand(6, 9, 5, generator=gen, dtype=torch.float64)
+    dense = nearest_columns(_pairwise_d2(xr, xo), 5)
+    sparse = nearest_obstacle_nodes(xr, xo, 5)
+    for a, b in zip(dense, sparse, strict=True):
+        torch.testing.assert_close(a, b, rtol=0, atol=0)
+    grads = [
+        torch.autograd.grad((weights * (near + log_phi)).sum(), xr)[0]
+        for _, log_phi, near in (dense, sparse)
+    ]
+    torch.testing.assert_close(grads[0], grads[1], rtol=1e-12, atol=1e-12)
 
 
 def reference_distance_and_grad(

@@ -206,6 +206,27 @@ def nearest_columns(dist: torch.Tensor, c: int) -> tuple[torch.Tensor, torch.Ten
     return idx, log_phi, near
 
 
+def nearest_obstacle_nodes(
+    xr: torch.Tensor, xo: torch.Tensor, c: int
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """:func:`nearest_columns` of the robot–obstacle squared distances, c ≤ N_o, with a sparse
+    gradient.
+
+    The c nearest obstacle nodes are chosen on the dense (B, N_r, N_o) distances without
+    autograd; their d²_c = |x_r − x_o,c|² are then recomputed from the (B, N_r, c, 2) differences
+    (the same floating-point operations, so the same values): the backward pass touches c
+    candidates per robot node instead of all N_o obstacle nodes.
+
+    Args:
+        xr: (B, N_r, 2) robot nodes; xo: (N_o, 2) obstacle nodes (normalised units).
+    """
+    with torch.no_grad():
+        idx = torch.topk(_pairwise_d2(xr, xo), c, dim=-1, largest=False).indices  # ascending
+    diff = xr[..., None, :] - xo[idx]
+    near = (diff * diff).sum(-1)
+    return idx, (near[..., -1:] - near).clamp_min(1e-12).log(), near
+
+
 def _softmax_small(logits: torch.Tensor) -> torch.Tensor:
     """Softmax over a short last dimension (the C candidates): exp(l − max l) / Σ exp(l − max l).
 
@@ -259,9 +280,9 @@ class _LeakyRingMessages(torch.autograd.Function):
         pre[:, 2] = c
         acts = [nn.functional.leaky_relu_(pre, LEAKY_SLOPE)]
         for w, bias in zip(weights[::2], weights[1::2], strict=True):
-            acts.append(
-                nn.functional.leaky_relu_(nn.functional.linear(acts[-1], w, bias), LEAKY_SLOPE)
-            )
+            # a product then an in-place bias: faster than linear's addmm, which first copies the
+            # broadcast bias into its (B·3·N, H) output
+            acts.append(nn.functional.leaky_relu_((acts[-1] @ w.T).add_(bias), LEAKY_SLOPE))
         ctx.save_for_backward(ring, *weights[::2], *acts)
         return acts[-1].sum(1)
 
@@ -566,8 +587,7 @@ class GraphDistNet(nn.Module):
         c, fixed = self.config, scene.fixed
         b, n_o = nodes.shape[0], len(scene.obstacles)
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
-        d2 = _pairwise_d2(xr, scene.obstacles)
-        idx, log_phi, near = nearest_columns(d2, min(c.cross_k + 1, n_o))
+        idx, log_phi, near = nearest_obstacle_nodes(xr, scene.obstacles, min(c.cross_k + 1, n_o))
         h, pooled = None, None
         for k in range(c.layers):
             logits = log_phi - near / self.log_tau[k].exp()
