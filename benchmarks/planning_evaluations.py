@@ -1,8 +1,9 @@
-"""Where a Table II (d) solve's work goes: constraint evaluations, Ipopt iterations, time, cost.
+"""Where a Table II solve's work goes: constraint evaluations, Ipopt iterations, time, cost.
 
-Plans the 20 (d) reaching problems of ``gdnplan.table2.reaching_problems("d")`` with Ipopt
-and one collision model, and prints per problem: certified or not, wall time (s), batched
-constraint evaluations (model passes), Ipopt iterations and path cost (rad²), then the medians.
+Plans the 20 reaching problems of ``gdnplan.table2.reaching_problems(setting)`` (``--setting``
+d, b or fetch; default d) with Ipopt and one collision model, and prints per problem:
+certified or not, wall time (s), batched constraint evaluations (model passes), Ipopt
+iterations and path cost (rad²), then the medians.
 Evaluation and iteration counts are deterministic for a given ``--threads`` (torch threads,
 default 1; a different count changes the float32 sums and so Ipopt's path), so solver settings
 can be compared on a busy machine by counts; compare times only within one run.
@@ -10,6 +11,7 @@ can be compared on a busy machine by counts; compare times only within one run.
     .venv/bin/python benchmarks/planning_evaluations.py --model GraphDistNet
     .venv/bin/python benchmarks/planning_evaluations.py --model coal \
         --ipopt limited_memory_initialization=scalar1 --set obj_change_tol=1e-4
+    .venv/bin/python benchmarks/planning_evaluations.py --setting fetch --set interpolated=3
 
 ``--ipopt name=value`` sets an extra Ipopt option (``TrajoptOptions.ipopt``), ``--set
 name=value`` a ``TrajoptOptions`` field (values parsed as JSON, else kept as strings).
@@ -25,8 +27,8 @@ import numpy as np
 import torch
 
 import gdnplan as gp
-from gdnplan.table2 import reaching_problems
-from gdnplan.trajopt import WEIGHTS_DIR, TrajoptOptions
+from gdnplan.table2 import SETTINGS, model_factory, reaching_problems
+from gdnplan.trajopt import TrajoptOptions
 
 
 def _pairs(items: list[str]) -> dict:
@@ -43,6 +45,7 @@ def _pairs(items: list[str]) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="GraphDistNet", choices=["GraphDistNet", "coal"])
+    parser.add_argument("--setting", default="d", choices=list(SETTINGS))
     parser.add_argument("--n", type=int, default=20)
     parser.add_argument("--ipopt", nargs="*", default=[], metavar="NAME=VALUE")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE")
@@ -50,14 +53,14 @@ def main() -> None:
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     opts = replace(TrajoptOptions(ipopt=_pairs(args.ipopt)), **_pairs(args.set))
-    model = "coal" if args.model == "coal" else gp.load_model(WEIGHTS_DIR / "d.safetensors")
-    problems = reaching_problems("d")[: args.n]
-    gp.plan(problems[0], collision=model, options=opts)  # warm-up: imports, scene caches
+    model_of = model_factory(args.model, args.setting)
+    problems = reaching_problems(args.setting)[: args.n]
+    gp.plan(problems[0], collision=model_of(problems[0]), options=opts)  # warm-up: imports
     print("| problem | certified | time (s) | evaluations | iterations | path cost (rad²) |")
     print("|---|---|---|---|---|---|")
     rows = []
     for i, problem in enumerate(problems):
-        r = gp.plan(problem, collision=model, options=opts)
+        r = gp.plan(problem, collision=model_of(problem), options=opts)
         rows.append((r.success, r.solve_time, r.model_calls, r.iterations, r.path_cost))
         print(
             f"| {i} | {r.success} | {r.solve_time:.2f} | {r.model_calls} | {r.iterations} "
@@ -66,7 +69,8 @@ def main() -> None:
         )
     ok, t, calls, iters, cost = (np.array(c) for c in zip(*rows, strict=True))
     print(
-        f"\n{args.model}: {ok.sum()}/{len(ok)} certified, median time {np.median(t):.2f} s, "
+        f"\n{args.model} ({args.setting}): {ok.sum()}/{len(ok)} certified, "
+        f"median time {np.median(t):.2f} s, "
         f"median evaluations {np.median(calls):.1f}, median iterations {np.median(iters):.1f}, "
         f"mean path cost {cost.mean():.3f} rad² (options: ipopt={opts.ipopt}, set={args.set}, "
         f"threads={args.threads})"

@@ -241,3 +241,39 @@ def test_ipopt_solves_planar2_around_a_square_with_graphdistnet(square):
     assert result.success, result.reason
     assert result.iterations > 0
     assert verify_path(square, result.q)[0]
+
+
+class _BatchSizes:
+    """A DistanceModel (coal's overall distance) that records the batch size of every call."""
+
+    name = "batch sizes"
+
+    def __init__(self):
+        self.coal, self.sizes = CoalModel(), []
+
+    def distance(self, scene, q):
+        self.sizes.append(len(q))
+        return self.coal.distance(scene, q)
+
+    def distance_and_grad(self, scene, q):
+        self.sizes.append(len(q))
+        return self.coal.distance_and_grad(scene, q)
+
+
+@pytest.mark.parametrize(
+    ("solver", "interpolated", "points"),
+    [("ipopt", None, 2), ("adam", None, 3), ("ipopt", 1, 1), ("adam", 0, 0)],
+)
+def test_check_points_per_segment_follow_the_solver_default(square, solver, interpolated, points):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    model = _BatchSizes()
+    opts = TrajoptOptions(interpolated=interpolated, initial="rrt", refine_rounds=0, starts=1)
+    plan(p, collision=model, solver=solver, options=opts)
+    inner = (p.waypoints - 1) * (points + 1) - 1  # Ipopt has no rows at start and goal
+    assert model.sizes[-1] == (inner if solver == "ipopt" else inner + 2)
+
+
+def test_negative_interpolated_raises(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    with pytest.raises(gp.GdnplanError, match="interpolated"):
+        plan(p, collision="coal", options=TrajoptOptions(interpolated=-1, initial="rrt"))
