@@ -219,26 +219,15 @@ class RobotGraph:
     def kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Node positions (B, N, 2) and joint positions (B, dof, 2) at q (B, dof) (m).
 
-        Body b (after the first b joints) moves rigidly, x ↦ R(θ_b) x + t_b, with
-        θ_b = Σ_{j<b} s_j q_j, t_0 = 0 and, joint j sitting on body j,
-
-            o_j(q) = R(θ_j) o_j⁰ + t_j,   t_{j+1} = o_j(q) − R(θ_{j+1}) o_j⁰,
-
-        so a node on body b is at p = R(θ_b) p⁰ + t_b: O(B (dof + N)) work, no per-joint copies.
+        Body b moves rigidly, x ↦ R(θ_b) x + t_b (:meth:`~gdnplan.robot.Robot.body_poses`), so a
+        node on body b is at p = R(θ_b) p⁰ + t_b and joint j, sitting on body j, at
+        o_j(q) = R(θ_j) o_j⁰ + t_j: O(B (dof + N)) work, no per-joint copies.
         """
-        q = self.robot.check_q(q)
-        chain = self.robot.chain
-        theta = np.zeros((len(q), chain.dof + 1))
-        np.cumsum(q * chain.joint_signs, 1, out=theta[:, 1:])
-        cos, sin = np.cos(theta), np.sin(theta)
-        t = np.zeros((len(q), chain.dof + 1, 2))
-        joints = np.empty((len(q), chain.dof, 2))
-        for j, (ox, oy) in enumerate(chain.joint_origins):
-            joints[:, j] = _rotate(cos[:, j], sin[:, j], ox, oy) + t[:, j]
-            t[:, j + 1] = joints[:, j] - _rotate(cos[:, j + 1], sin[:, j + 1], ox, oy)
-        c, s = cos[:, self.body], sin[:, self.body]  # (B, N)
-        x, y = self.nodes0[:, 0], self.nodes0[:, 1]
-        nodes = np.stack([c * x - s * y, s * x + c * y], -1) + t[:, self.body]
+        poses = self.robot.body_poses(q)  # (B, dof + 1, 3)
+        t, cos, sin = poses[..., :2], np.cos(poses[..., 2]), np.sin(poses[..., 2])
+        dof = self.robot.dof
+        joints = _rotate(cos[:, :dof], sin[:, :dof], self.robot.chain.joint_origins) + t[:, :dof]
+        nodes = _rotate(cos[:, self.body], sin[:, self.body], self.nodes0) + t[:, self.body]
         return nodes, joints
 
     def positions(self, q: np.ndarray) -> np.ndarray:
@@ -291,8 +280,9 @@ class RobotGraph:
         return GraphBatch(nodes, prev, next, mask)
 
 
-def _rotate(c: np.ndarray, s: np.ndarray, x: float, y: float) -> np.ndarray:
-    """(B, 2) rotations R(θ) (x, y) given cos θ and sin θ (B,)."""
+def _rotate(c: np.ndarray, s: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(B, N, 2) rotations R(θ_bn) p_n of points (N, 2) given cos θ and sin θ (B, N)."""
+    x, y = points[:, 0], points[:, 1]
     return np.stack([c * x - s * y, s * x + c * y], -1)
 
 

@@ -258,13 +258,23 @@ class Robot:
     def body_poses(self, q: np.ndarray) -> np.ndarray:
         """(B, dof + 1, 3) planar poses (x, y, θ) of every body; body 0 is the fixed base.
 
-        The pose maps q = 0 plane coordinates of a body point p⁰ to p = R(θ)p⁰ + (x, y).
+        The pose maps q = 0 plane coordinates of a body point p⁰ to p = R(θ)p⁰ + (x, y). Body b
+        hangs from joint b − 1 at o_{b−1} (q = 0 coordinates), so composing one joint more,
+
+            θ_b = θ_{b−1} + s_{b−1} q_{b−1},    t_b = t_{b−1} + R(θ_{b−1}) o_{b−1} − R(θ_b) o_{b−1},
+
+        with θ_0 = 0, t_0 = 0: two cumulative sums over the chain, no loop over joints.
         """
         q = self.check_q(q)
         theta = np.concatenate([np.zeros((len(q), 1)), np.cumsum(q * self.chain.joint_signs, 1)], 1)
-        zero = np.zeros((1, 2))
-        bodies = np.arange(self.dof + 1)
-        origin = self.chain.transform(np.repeat(zero, self.dof + 1, 0), bodies, q)  # image of 0
+        c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]  # (B, dof + 1, 1)
+        ox, oy = self.chain.joint_origins[:, :1], self.chain.joint_origins[:, 1:]  # (dof, 1)
+
+        def rotated(k: slice) -> np.ndarray:  # R(θ_k) o (B, dof, 2) for θ_k = θ[:, k]
+            return np.concatenate([c[:, k] * ox - s[:, k] * oy, s[:, k] * ox + c[:, k] * oy], -1)
+
+        steps = rotated(slice(0, -1)) - rotated(slice(1, None))
+        origin = np.concatenate([np.zeros((len(q), 1, 2)), np.cumsum(steps, 1)], 1)
         return np.concatenate([origin, theta[..., None]], -1)
 
     def node_positions_pinocchio(self, q: np.ndarray) -> np.ndarray:

@@ -64,6 +64,19 @@ def test_body_poses_place_bodies():
     np.testing.assert_allclose(pose[2], [0.6, 0.6, np.pi], atol=1e-12)
 
 
+@pytest.mark.parametrize("name", ["planar7", "ur5e"])
+def test_body_poses_equal_the_chain_transform(name):
+    robot = gp.load_robot(name)
+    q = robot.sample(50, seed=0)
+    poses = robot.body_poses(q)
+    bodies = np.arange(robot.dof + 1)
+    origin = robot.chain.transform(np.zeros((robot.dof + 1, 2)), bodies, q)  # image of 0
+    np.testing.assert_allclose(poses[..., :2], origin, atol=1e-12)
+    unit_x = robot.chain.transform(np.tile([1.0, 0.0], (robot.dof + 1, 1)), bodies, q) - origin
+    np.testing.assert_allclose(np.cos(poses[..., 2]), unit_x[..., 0], atol=1e-12)
+    np.testing.assert_allclose(np.sin(poses[..., 2]), unit_x[..., 1], atol=1e-12)
+
+
 @pytest.mark.parametrize(
     ("q", "message"),
     [(np.zeros(3), "shape"), (np.array([0.0, np.nan]), "NaN"), ("ab", "numbers")],
