@@ -122,15 +122,25 @@ def shortcut(
     scene: Scene, path: np.ndarray, clearance: float, attempts: int = 100, seed: int = 0
 ) -> np.ndarray:
     """Random shortcutting: replace the stretch between two random vertices by a straight
-    segment whenever that segment is certified free; path (K, dof) -> (K', dof)."""
+    segment whenever that segment is certified free; path (K, dof) -> (K', dof).
+
+    A short path offers few vertex pairs, so draws repeat: a pair whose segment failed the
+    check is remembered and not checked again (the check is deterministic, so the result is
+    the same as re-checking)."""
     rng = np.random.default_rng(seed)
     path = path.copy()
+    blocked: set[tuple[bytes, bytes]] = set()
     for _ in range(attempts):
         if len(path) <= 2:
             break
         i, j = np.sort(rng.choice(len(path), 2, replace=False))
-        if j - i > 1 and edge_free(scene, path[i], path[j], clearance):
+        pair = (path[i].tobytes(), path[j].tobytes())
+        if j - i <= 1 or pair in blocked:
+            continue
+        if edge_free(scene, path[i], path[j], clearance):
             path = np.vstack([path[: i + 1], path[j:]])
+        else:
+            blocked.add(pair)
     return path
 
 
