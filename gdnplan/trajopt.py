@@ -316,7 +316,8 @@ class TrajoptOptions:
         per_link: one distance row per link polygon (capped at ``link_cap``) instead of one;
             None: when the model provides per-link distances (coal does).
         interpolated: M check points strictly between consecutive waypoints (before refining);
-            None: 2 for Ipopt, 3 for Adam. Ipopt with 2 rather than 3 (the CCD certificate and
+            None: 2 for Ipopt, 3 for Adam; Ipopt adds one per restart (``_plan_ipopt``).
+            Ipopt with 2 rather than 3 (the CCD certificate and
             refine rounds catch what the coarser check points miss) solved every Table II
             problem either way and took 25 % less time with GraphDistNet on (d) (a network pass
             per evaluation costs about linearly in the check points) for +1 % mean path cost;
@@ -543,17 +544,28 @@ def _line_free(problem: Problem, line: np.ndarray) -> bool:
 
 
 def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, seed: int) -> _Run:
+    """Straight line when certified free, else Ipopt from one seed per attempt.
+
+    An attempt that ends uncertified suggests check points too sparse for the problem, so
+    attempt a (0-based) starts with ``interpolated + a`` check points per segment: on one (d)
+    problem (#14, two torch threads) all three attempts with 2 check points ended uncertified
+    (the path slipped through an obstacle between them), a second attempt with 3 succeeded.
+    """
     line = straight_line(problem.start, goal, problem.waypoints)
     if opts.initial == "auto" and _line_free(problem, line):
         status = "straight line certified free (optimal path cost, no solve needed)"
         return _Run(q=line, status=status, reason=status)
     run = _Run(q=line)
-    for label, guess in _seeds(problem, goal, opts, seed):
+    first = _interpolated(opts, IPOPT_INTERPOLATED)
+    for attempt, (label, guess) in enumerate(_seeds(problem, goal, opts, seed)):
         run.attempts += 1
         if guess is None:
             run.reason = f"{run.reason}; {label}: RRT-Connect found no path".lstrip("; ")
             continue
-        q, stats, ok = _solve_refined(problem, model, goal, opts, guess, run)
+        if attempt:
+            label = f"{label}, {first + attempt} check points per segment"
+        denser = replace(opts, interpolated=first + attempt)
+        q, stats, ok = _solve_refined(problem, model, goal, denser, guess, run)
         run.q, run.status = q, stats.get("return_status", "exception")
         if ok:
             run.reason = f"{label}: {run.status}"

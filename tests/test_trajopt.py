@@ -277,3 +277,25 @@ def test_negative_interpolated_raises(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     with pytest.raises(gp.GdnplanError, match="interpolated"):
         plan(p, collision="coal", options=TrajoptOptions(interpolated=-1, initial="rrt"))
+
+
+class _Liar(_BatchSizes):
+    """Claims 1 m of clearance everywhere (zero gradient): Ipopt straightens every seed path
+    through the square and coal rejects it, so every attempt fails."""
+
+    def distance(self, scene, q):  # the overestimate check after a failed round: not recorded
+        return np.ones(len(q))
+
+    def distance_and_grad(self, scene, q):  # the NLP's constraint evaluations
+        self.sizes.append(len(q))
+        return np.ones(len(q)), np.zeros_like(q)
+
+
+def test_each_restart_adds_a_check_point_per_segment(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    model = _Liar()
+    opts = TrajoptOptions(initial="rrt", refine_rounds=0, starts=3)
+    result = plan(p, collision=model, options=opts)
+    assert not result.success and result.attempts == 3
+    batches = list(dict.fromkeys(model.sizes))  # distinct NLP sizes, in order
+    assert batches[:3] == [(p.waypoints - 1) * (m + 1) - 1 for m in (2, 3, 4)]
