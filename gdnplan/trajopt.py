@@ -317,11 +317,10 @@ class TrajoptOptions:
             None: when the model provides per-link distances (coal does).
         interpolated: M check points strictly between consecutive waypoints (before refining);
             None: 2 for Ipopt, 3 for Adam; Ipopt adds one per restart (``_plan_ipopt``).
-            Ipopt with 2 rather than 3 (the CCD certificate and
-            refine rounds catch what the coarser check points miss) solved every Table II
-            problem either way and took 25 % less time with GraphDistNet on (d) (a network pass
-            per evaluation costs about linearly in the check points) for +1 % mean path cost;
-            on the fetch layouts 34 % less for 4 % lower cost (benchmarks/RESULTS.md). Adam's
+            With 2 rather than 3 (the CCD certificate and refine rounds catch what the sparser
+            check points miss) Ipopt with GraphDistNet took 25 % less time on (d) (a network
+            pass costs about linearly in the check points) for +1 % mean path cost, 34 % less
+            on the fetch layouts, 20 % more on (b), all 20/20 (benchmarks/RESULTS.md). Adam's
             stop test reads the check points alone, so Adam keeps the paper-baseline density.
         starts: Ipopt attempts (new seed path each) before giving up.
         max_iter: Ipopt iteration cap per attempt.
