@@ -563,8 +563,8 @@ def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, 
             continue
         if attempt:
             label = f"{label}, {first + attempt} check points per segment"
-        denser = replace(opts, interpolated=first + attempt)
-        q, stats, ok = _solve_refined(problem, model, goal, denser, guess, run)
+        attempt_opts = replace(opts, interpolated=first + attempt)
+        q, stats, ok = _solve_refined(problem, model, goal, attempt_opts, guess, run)
         run.q, run.status = q, stats.get("return_status", "exception")
         if ok:
             run.reason = f"{label}: {run.status}"
