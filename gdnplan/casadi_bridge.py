@@ -12,8 +12,8 @@ and one batched ``distance_and_grad`` call yields both the values and the Jacobi
 costs one model pass. A model with ``distance_deferred_grad`` (GraphDistNet) computes the
 Jacobian only when Ipopt asks for it: the line search's rejected trial points (30 % of the
 evaluations on the (d) problems with Ipopt's default L-BFGS start, few with ``scalar2``) then
-cost a forward pass alone. Build the NLP with MX
-symbols (SX would call the callback per nonzero).
+cost a forward pass alone. Build the NLP with MX symbols (SX would call the callback per
+nonzero).
 """
 
 from __future__ import annotations

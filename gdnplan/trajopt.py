@@ -550,12 +550,12 @@ def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, 
     problem (#14, two torch threads) all three attempts with 2 check points ended uncertified
     (the path slipped through an obstacle between them), a second attempt with 3 succeeded.
     """
+    first = _interpolated(opts, IPOPT_INTERPOLATED)  # bad input fails even on a free line
     line = straight_line(problem.start, goal, problem.waypoints)
     if opts.initial == "auto" and _line_free(problem, line):
         status = "straight line certified free (optimal path cost, no solve needed)"
         return _Run(q=line, status=status, reason=status)
     run = _Run(q=line)
-    first = _interpolated(opts, IPOPT_INTERPOLATED)
     for attempt, (label, guess) in enumerate(_seeds(problem, goal, opts, seed)):
         run.attempts += 1
         if guess is None:
@@ -586,7 +586,7 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
     (:meth:`_Transcription.duals_on`): on three (d) problems with one-way GraphDistNet weights
     the second rounds took 36, 61 and 13 Ipopt iterations instead of 53, 130 and 85.
     """
-    splits = np.full(problem.waypoints - 1, _interpolated(opts, IPOPT_INTERPOLATED) + 1)
+    splits = np.full(problem.waypoints - 1, opts.interpolated + 1)  # set by _plan_ipopt
     per_link = supports_per_link(model) if opts.per_link is None else opts.per_link
     learned = not isinstance(model, CoalModel)
     margin = problem.margin + (opts.learned_margin if learned else 0.0)
