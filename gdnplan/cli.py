@@ -346,7 +346,11 @@ def generate_command(
     split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
     n: int = typer.Option(None, help="Samples (default: the paper's 50 000 / 5 000)."),
     seed: int = typer.Option(None, help="Override the split's seed."),
-    near: float = typer.Option(0.0, help="Fraction of samples drawn near contact (ur5e)."),
+    near: float = typer.Option(
+        0.0,
+        help="Fraction of samples drawn near contact: around the fetch task (ur5e), "
+        "|f| < 3 cm (a-e).",
+    ),
     workers: int = typer.Option(None, help="Worker processes (default: all cores)."),
     data: Path = typer.Option(None, help="Data root (default data/): <data>/<env>/<split>."),
 ) -> None:
@@ -383,6 +387,9 @@ def train_command(
     compile: bool = typer.Option(False, "--compile", help="torch.compile the training step."),
     init: Path = typer.Option(
         None, help="Fine-tune from these GraphDistNet weights (their card's config; --set applies)."
+    ),
+    extra: list[Path] = typer.Option(
+        [], help="More training shards (a directory, e.g. from generate --near); repeatable."
     ),
 ) -> None:
     """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
@@ -425,6 +432,7 @@ def train_command(
         run_dir=run_dir,
         compile=compile,
         init=init,
+        extra=extra,
     )
     typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
 

@@ -35,6 +35,11 @@ uniform fraction s: q_ref = q_a + s (q_b − q_a)), where uniform samples rarely
 contacts, down to the millimetres of the stick resting on its shelf (at 0.005 rad the tcp moves
 ≈ 3 mm).
 
+For the environments a–e, ``near`` > 0 concentrates that fraction of the samples at the
+collision boundary instead (beyond the paper, for AUC and gradients where they matter): a
+near-boundary sample is q uniform within the limits conditioned on |f(q)| < ``BOUNDARY_BAND``,
+drawn by rejection (uniform candidates labelled by coal, the first ones inside the band kept).
+
 Shard arrays (n samples, P obstacles of at most V vertices, N robot nodes):
 
 ========== ================= ====================================================
@@ -64,7 +69,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .distance import signed_distance_and_grad
+from .distance import signed_distance, signed_distance_and_grad
 from .errors import InputError, UnknownNameError
 from .robot import Robot, load_robot
 from .scene import ENV_ROBOT, Scene, clear_of_base, make_scene
@@ -80,6 +85,7 @@ ENVS = (*ENV_ROBOT, "ur5e")
 UR5E_LAYOUTS = 300  # fetch layouts per split
 FETCH_SEED_BASE = 10_000  # first fetch seed of the dataset layouts (benchmarks use smaller)
 CANONICAL_SHARE = 0.1  # fraction of ur5e train samples on the canonical layout (fetch seed 0)
+BOUNDARY_BAND = 0.03  # m: near-boundary samples of a–e have |f| below this
 NEAR_SIGMA = (0.005, 0.2)  # rad: range of the log-uniform spread of the near-contact samples
 NEAR_REFS = {  # gripper state -> fetch configurations the near-contact samples spread around
     "open": ("q_home", "q_pregrasp", "q_grasp"),
@@ -267,22 +273,44 @@ def make_ur5e_shard(seed: int, start: int, n: int, near: float = 0.0) -> Dataset
     return Dataset("ur5e", q, padded, obstacles_arr, sizes, d, grad, layout, gripper, stick)
 
 
+def near_boundary(scene: Scene, k: int, rng: np.random.Generator) -> np.ndarray:
+    """(k, dof) configurations uniform within the limits conditioned on |f| < BOUNDARY_BAND
+    (rejection sampling in batches of uniform candidates labelled by coal)."""
+    robot = scene.robot
+    batch = min(4096, max(256, 40 * k))
+    kept = [np.empty((0, robot.dof))]
+    found = 0
+    for _ in range(10_000):
+        if found >= k:
+            return np.concatenate(kept)[:k]
+        candidates = robot.sample(batch, seed=rng.integers(2**63))
+        inside = candidates[np.abs(signed_distance(scene, candidates)) < BOUNDARY_BAND]
+        kept.append(inside)
+        found += len(inside)
+    raise InputError(f"near: no configurations within {BOUNDARY_BAND} m of contact in {scene.name}")
+
+
 def make_shard(env: str, seed: int, start: int, n: int, near: float = 0.0) -> Dataset:
     """Samples ``start … start + n − 1`` of the split of ``env`` with ``seed`` (``near``:
-    fraction of near-contact samples, ``ur5e`` only)."""
+    fraction of near-contact samples, see the module docstring)."""
     if env == "ur5e":
         return make_ur5e_shard(seed, start, n, near)
     base = make_scene(env, seed=0)
     robot = base.robot
     q = robot.sample(n, seed=[seed, start])
     scene_seed = seed * 10**8 + start + np.arange(n, dtype=np.int64)
+    rng = np.random.default_rng([seed, start, 11])
+    is_near = rng.random(n) < near if near > 0 else np.zeros(n, bool)
     if env in RANDOM_ENVS:
         scenes = [make_scene(env, seed=int(s)) for s in scene_seed]
+        for i in np.flatnonzero(is_near):
+            q[i] = near_boundary(scenes[i], 1, rng)[0]
         labels = [signed_distance_and_grad(s, qi[None]) for s, qi in zip(scenes, q, strict=True)]
         d = np.concatenate([lab[0] for lab in labels])
         grad = np.concatenate([lab[1] for lab in labels])
         polys = [list(s.obstacles) for s in scenes]
     else:
+        q[is_near] = near_boundary(base, int(is_near.sum()), rng)
         chunks = [signed_distance_and_grad(base, c) for c in np.array_split(q, -(-n // 500))]
         d, grad = (np.concatenate(x) for x in zip(*chunks, strict=True))  # no nested pools
         polys = [list(base.obstacles)] * n
@@ -322,7 +350,8 @@ def generate(
         seed: split seed (train 0, test 1 by convention, see ``SPLITS``).
         out_dir: directory of the shards (created).
         workers: processes (default: all cores).
-        near: fraction of near-contact samples (``ur5e`` only, see the module docstring).
+        near: fraction of near-contact samples (module docstring: around the fetch task for
+            ``ur5e``, at the collision boundary for a–e).
 
     Returns:
         ``out_dir``.
@@ -333,8 +362,8 @@ def generate(
         raise InputError(f"n: expected a positive number of samples, got {n}")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    if near and env != "ur5e":
-        raise InputError(f"near: near-contact sampling is for env 'ur5e' only, not {env!r}")
+    if not 0.0 <= near <= 1.0:
+        raise InputError(f"near: expected a fraction in [0, 1], got {near}")
     jobs = [
         (env, seed, s, k, str(p), near) for s, k, p in shard_paths(out_dir, n) if not p.exists()
     ]
@@ -366,6 +395,26 @@ def load(path: Path | str, n: int | None = None) -> Dataset:
         total += len(parts[-1]["q"])
         if n is not None and total >= n:
             break
+    return _join(parts, n)
+
+
+def concat(datasets: list[Dataset]) -> Dataset:
+    """One dataset of the samples of ``datasets`` in order (polygons padded to the largest)."""
+    if not datasets:
+        raise InputError("concat: no datasets")
+    parts = [
+        {f: getattr(ds, f) for f in (*FIELDS, *ROBOT_FIELDS) if getattr(ds, f) is not None}
+        | {"env": ds.env}
+        for ds in datasets
+    ]
+    if len({p["env"] for p in parts}) > 1:
+        envs = [ds.env for ds in datasets]
+        raise InputError(f"concat: datasets of different environments {envs}")
+    return _join(parts, None)
+
+
+def _join(parts: list[dict], n: int | None) -> Dataset:
+    """Pad the arrays of ``parts`` (dicts of the shard fields) alike and join them."""
     n_poly = max(p["obstacles"].shape[1] for p in parts)
     n_vert = max(p["obstacles"].shape[2] for p in parts)
     n_nodes = max(p["nodes"].shape[1] for p in parts)

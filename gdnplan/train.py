@@ -29,6 +29,7 @@ import math
 import os
 import subprocess
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,7 +39,7 @@ from safetensors.torch import load_file, save_file
 from scipy.stats import rankdata
 from tqdm import tqdm
 
-from .data import DATA_DIR, Dataset, env_robot, load, split_dir
+from .data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from .errors import InputError
 from .evaluate import sha256_prefix
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
@@ -293,6 +294,7 @@ def train(
     run_dir: Path | str | None = None,
     compile: bool = False,
     init: Path | str | None = None,
+    extra: Sequence[Path | str] = (),
 ) -> dict:
     """Train GraphDistNet on ``data/<env>/train``, evaluate on ``data/<env>/test``, save weights.
 
@@ -308,6 +310,9 @@ def train(
             of compilation); validation and evaluation stay eager.
         init: fine-tune: start from these weights (same architecture as ``config``) instead
             of a random initialisation; ignored when the run resumes from its checkpoint.
+        extra: more training splits (directories of shards, e.g. near-boundary samples from
+            ``gdnplan generate --near``), added to the training part only: validation stays
+            the 10 % of ``data/<env>/train``, the distribution of the test split.
 
     Returns:
         The card written beside the weights (config, data, training log, test metrics).
@@ -323,7 +328,11 @@ def train(
     full = load(split_dir(env, "train", data_root), n_train)
     order = np.random.default_rng(seed).permutation(len(full))
     n_val = max(len(full) // 10, 1)
-    train_t = tensors(full.subset(order[n_val:]), config)
+    extra_sets = [load(path) for path in extra]
+    for path, ds in zip(extra, extra_sets, strict=True):
+        if ds.env != env:
+            raise InputError(f"extra: {path} holds samples of env {ds.env!r}, not {env!r}")
+    train_t = tensors(concat([full.subset(order[n_val:]), *extra_sets]), config)
     val_t = tensors(full.subset(order[:n_val]), config)
     net = GraphDistNet(config).to(device)
     if init is not None:
@@ -415,6 +424,7 @@ def train(
             "train_seed": 0,
             "n_train": n,
             "n_val": len(val_t),
+            "extra": {str(path): len(ds) for path, ds in zip(extra, extra_sets, strict=True)},
             "test_seed": 1,
             "n_test": test["n"],
         },

@@ -113,14 +113,22 @@ def test_generate_then_train_writes_loadable_weights(tmp_path):
     d = model.distance(scene, scene.robot.sample(5, seed=0))
     assert d.shape == (5,) and np.isfinite(d).all()
 
-    # fine-tune from those weights: zero learning rate keeps them, the card records the start
+    # fine-tune from those weights with extra near-boundary samples: zero learning rate keeps
+    # them, the card records the start and the extra data
+    near = tmp_path / "near"
+    args = ["generate", "--env", "a", "--seed", "5", "--near", "1", "--n", "30", "--data",
+            str(near), "--workers", "1"]  # fmt: skip
+    assert runner.invoke(app, args).exit_code == 0
     tuned = tmp_path / "a_tuned.safetensors"
     args = ["train", "--env", "a", "--data", str(data), "--out", str(tuned), "--epochs", "1",
-            "--lr", "0", "--init", str(out), "--run-dir", str(tmp_path / "run2")]  # fmt: skip
+            "--lr", "0", "--init", str(out), "--run-dir", str(tmp_path / "run2"),
+            "--extra", str(near / "a" / "train")]  # fmt: skip
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     card = json.loads(tuned.with_suffix(".json").read_text())
     assert card["config"]["layers"] == 1 and card["init"]["path"] == str(out)
+    assert card["data"]["extra"] == {str(near / "a" / "train"): 30}
+    assert card["data"]["n_train"] == 72 + 30
     np.testing.assert_allclose(
         gp.load_model(tuned).distance(scene, scene.robot.sample(5, seed=0)), d
     )

@@ -109,4 +109,19 @@ def test_ur5e_near_contact_samples_spread_around_the_task_configurations(tmp_pat
         refs = [fetch.info[k] for k in ("q_home", "q_pregrasp", "q_grasp", "q_lift", "q_out")]
         assert min(np.abs(ds.q[i] - r).max() for r in refs) < 6 * max(data.NEAR_SIGMA)
     with pytest.raises(gp.InputError):
-        data.generate("d", 10, 0, tmp_path, near=0.5)
+        data.generate("d", 10, 0, tmp_path, near=1.5)
+
+
+@pytest.mark.parametrize("env", ["a", "d"])  # fixed scene, one scene per sample
+def test_near_boundary_samples_lie_in_the_band_with_coal_labels(env):
+    ds = data.make_shard(env, seed=3, start=0, n=40, near=0.5)
+    near = np.abs(ds.d) < data.BOUNDARY_BAND
+    uniform = data.make_shard(env, seed=3, start=0, n=40)
+    assert near.sum() >= 10  # about half the samples, and uniform ones rarely fall in the band
+    assert near.sum() > 3 * (np.abs(uniform.d) < data.BOUNDARY_BAND).sum()
+    for i in range(0, 40, 7):
+        d, g = gp.signed_distance_and_grad(ds.scene(i), ds.q[i])
+        assert ds.d[i] == pytest.approx(d[0], abs=1e-9)
+        np.testing.assert_allclose(ds.grad[i], g[0], atol=1e-9)
+    robot = ds.robot(0)
+    assert robot.within_limits(ds.q).all()
