@@ -381,7 +381,8 @@ def train(
         seconds = time.perf_counter() - start
         trained += seconds
         val_hat, val_g = predict(net, val_t, device=device, grad=config.grad_weight > 0)
-        val_mae = float(np.mean(np.abs(val_hat - val_t.d.double().numpy())))
+        val_d = val_t.d.double().numpy()
+        val_mae = float(np.mean(np.abs(val_hat - val_d)))
         score = val_mae / config.scale  # model selection: the loss's terms on validation
         if val_g is not None:
             acd, _ = mean_cosine_distance(val_g, val_t.grad.double().numpy())
@@ -390,6 +391,7 @@ def train(
             "epoch": epoch,
             "train_loss": total / n,
             "val_mae_m": val_mae,
+            "val_auc": roc_auc(val_d <= 0, -val_hat),  # logged, not used for selection
             "val_score": score,
             "lr": state["lr"],
             "seconds": seconds,
