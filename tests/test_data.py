@@ -125,3 +125,19 @@ def test_near_boundary_samples_lie_in_the_band_with_coal_labels(env):
         np.testing.assert_allclose(ds.grad[i], g[0], atol=1e-9)
     robot = ds.robot(0)
     assert robot.within_limits(ds.q).all()
+
+
+def test_concat_pads_polygons_and_rejects_mixed_environments():
+    a = data.make_shard("b", seed=4, start=0, n=3)
+    b = data.make_shard("b", seed=4, start=3, n=2)
+    both = data.concat([a, b])
+    assert len(both) == 5 and both.obstacles.shape[1:3] == (
+        max(a.obstacles.shape[1], b.obstacles.shape[1]),
+        max(a.obstacles.shape[2], b.obstacles.shape[2]),
+    )
+    for i, (ds, j) in enumerate([(a, 0), (a, 1), (a, 2), (b, 0), (b, 1)]):
+        assert [p.tolist() for p in both.scene(i).obstacles] == [
+            p.tolist() for p in ds.scene(j).obstacles
+        ]
+    with pytest.raises(gp.InputError):
+        data.concat([a, data.make_shard("a", seed=4, start=0, n=2)])
