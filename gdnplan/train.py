@@ -317,6 +317,11 @@ def train(
     Returns:
         The card written beside the weights (config, data, training log, test metrics).
     """
+    if compile and config is not None and config.grad_weight > 0:
+        raise InputError(
+            "compile: the gradient loss (grad_weight > 0) differentiates ∂d̂/∂q, a double "
+            "backward that torch.compile does not support; train it without --compile"
+        )
     robot = env_robot(env)
     config = (config or GraphDistNetConfig.smooth()).with_(
         scale=round(robot.reach, 6), origin=tuple(float(v) for v in robot.chain.joint_origins[0])

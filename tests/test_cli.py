@@ -141,6 +141,7 @@ def test_generate_then_train_writes_loadable_weights(tmp_path):
         (["train", "--env", "a", "--preset", "fast"], "--preset: expected"),
         (["generate", "--env", "a", "--split", "val"], "--split: expected"),
         (["train", "--env", "a", "--init", "missing.safetensors"], "--init: no card"),
+        (["train", "--env", "a", "--compile", "--set", "grad_weight=0.1"], "double backward"),
     ],
 )
 def test_train_and_generate_reject_bad_options(args, message):
