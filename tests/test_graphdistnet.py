@@ -5,7 +5,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from shapely.geometry import LineString, Point
 
 import gdnplan as gp
 from gdnplan.data import load
@@ -18,7 +17,6 @@ from gdnplan.models.graphdistnet import (
     _repeat,
     nearest_columns,
     nearest_obstacle_nodes,
-    segment_partners,
 )
 from gdnplan.train import distance_loss, evaluate
 
@@ -44,14 +42,7 @@ def random_model(env: str, dtype=torch.float32, **changes) -> tuple[gp.Scene, Gr
 
 
 @pytest.mark.parametrize(
-    "changes",
-    [
-        {},
-        {"activation": "silu", "max_edge": 0.25},
-        {"two_way": False},
-        {"cross_segments": True},
-        {"cross_segments": True, "two_way": False},
-    ],
+    "changes", [{}, {"activation": "silu", "max_edge": 0.25}, {"two_way": False}]
 )
 def test_autograd_gradient_matches_finite_differences(changes):
     scene, model = random_model("e", torch.float64, **changes)
@@ -93,9 +84,8 @@ def test_deferred_gradient_equals_distance_and_grad(changes):
     np.testing.assert_array_equal(grad(), grad())  # asked twice: the same array, one backward
 
 
-@pytest.mark.parametrize("changes", [{}, {"cross_segments": True}])
-def test_permuting_obstacles_and_start_vertices_keeps_distance(changes):
-    scene, model = random_model("e", **changes)
+def test_permuting_obstacles_and_start_vertices_keeps_distance():
+    scene, model = random_model("e")
     q = scene.robot.sample(5, seed=4)
     rng = np.random.default_rng(0)
     shuffled = [np.roll(scene.obstacles[i], rng.integers(1, 5), 0) for i in rng.permutation(5)]
@@ -140,20 +130,6 @@ def test_sparse_nearest_nodes_equal_dense_selection_and_gradient():
     torch.testing.assert_close(grads[0], grads[1], rtol=1e-12, atol=1e-12)
 
 
-def test_segment_partners_are_the_closest_edge_points():
-    rng = np.random.default_rng(3)
-    xi = rng.uniform(-1, 1, (40, 2))
-    xc, xe = rng.uniform(-1, 1, (2, 40, 3, 2))
-    xe[:, 2] = xc[:, 2]  # a degenerate edge (padding) is its start point
-    delta, s2 = segment_partners(*(torch.from_numpy(a) for a in (xi, xc, xe)))
-    for i, c in np.ndindex(40, 3):
-        segment = LineString([xc[i, c], xe[i, c] + (c == 2) * 1e-15])
-        point = Point(xi[i])
-        closest = segment.interpolate(segment.project(point))
-        np.testing.assert_allclose(xc[i, c] + delta[i, c].numpy(), closest.coords[0], atol=1e-9)
-        assert float(s2[i, c]) == pytest.approx(point.distance(segment) ** 2, abs=1e-12)
-
-
 def reference_distance_and_grad(
     model: GraphDistNetModel, scene: gp.Scene, q: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -175,9 +151,6 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("d", {"mlp": ()}),
     ("d", {"two_way": False}),  # obstacle features cached per scene
     ("a", {"two_way": False, "activation": "silu"}),  # fewer obstacle nodes than candidates
-    ("c", {"cross_segments": True}),
-    ("a", {"cross_segments": True}),
-    ("d", {"two_way": False, "cross_segments": True}),
 ]
 
 
@@ -272,8 +245,6 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig(cross="nearest")
     with pytest.raises(gp.InputError):
         GraphDistNetConfig(activation="relu")
-    with pytest.raises(gp.InputError):
-        GraphDistNetConfig.faithful(cross_segments=True)
     with pytest.raises(gp.InputError):
         GraphDistNetConfig(contact_weight=-1.0)
     with pytest.raises(gp.InputError):

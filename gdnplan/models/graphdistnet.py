@@ -22,18 +22,6 @@ h_k an MLP R^4 → R^{d_h} (k = 0), R^{2 d_h + 4} → R^{d_h} (k > 0). The cross
   leaving the candidate set does so with zero weight: d̂ is a deterministic, continuous
   function of the node positions (and piecewise smooth).
 
-Segment partners (``cross_segments=True``, beyond the paper): candidate c stands for its
-outgoing polygon edge [x_c, x_e], e = next(c), and its position in z̄_i becomes the point of that
-edge closest to node i,
-
-    p_ic = x_c + t_ic (x_e − x_c),  t_ic = clamp((x_i − x_c)·(x_e − x_c) / |x_e − x_c|², 0, 1),
-
-and the soft weights use the point–segment distance s²_ic = |x_i − p_ic|² in place of d²_ic
-(φ keeps the node distances that chose the candidates). For convex polygons apart, the
-distance is the smallest of these point–segment distances over robot nodes and obstacle
-edges and the reverse, so the network no longer has to infer it from vertex positions alone;
-p_ic is continuous in the node positions, so d̂ stays continuous.
-
 One-way cross edges (``two_way=False``, beyond the paper): only robot nodes take a cross
 partner; obstacle nodes have z̄_i = z_i (no cross term), so x_o⁽ᵏ⁾, their scores and their
 readouts y_o⁽ᵏ⁾ depend on the scene alone. Inference computes them once per scene, and the
@@ -96,8 +84,6 @@ class GraphDistNetConfig:
         two_way: cross edges into both graphs (the paper). False: only robot nodes take a
             cross partner (obstacle nodes have z̄_i = z_i), so the obstacle features depend on
             the scene alone and inference computes them once per scene (module docstring).
-        cross_segments: ``soft_knn`` partners are the closest points on the candidates'
-            outgoing edges, weighted by point–segment distance (module docstring).
         tau: initial temperature τ of ``soft_knn`` (normalised units², learned per layer).
         max_edge: densify graph edges longer than this (m), or None.
         grad_weight: weight λ of the gradient loss λ · (1 − cos(∂d̂/∂q, ∂f/∂q)).
@@ -116,7 +102,6 @@ class GraphDistNetConfig:
     cross: str = "soft_knn"
     cross_k: int = 4
     two_way: bool = True
-    cross_segments: bool = False
     tau: float = 0.02
     max_edge: float | None = None
     grad_weight: float = 0.0
@@ -134,8 +119,6 @@ class GraphDistNetConfig:
             raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
         if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
             raise InputError("layers, hidden, cross_k and scale must be positive")
-        if self.cross_segments and self.cross != "soft_knn":
-            raise InputError("cross_segments needs cross='soft_knn'")
         if self.contact_weight < 0 or self.contact_scale <= 0:
             raise InputError("contact_weight must be ≥ 0 and contact_scale positive")
 
@@ -263,26 +246,6 @@ def _pairwise_d2(xr: torch.Tensor, xo: torch.Tensor) -> torch.Tensor:
     return dx * dx + dy * dy
 
 
-def segment_partners(
-    xi: torch.Tensor, xc: torch.Tensor, xe: torch.Tensor
-) -> tuple[torch.Tensor, torch.Tensor]:
-    """Closest points of candidate edges [x_c, x_e] to their nodes x_i (``cross_segments``).
-
-    Args:
-        xi: (..., 2) nodes; xc, xe: (..., C, 2) start and end of each candidate's edge
-            (x_e = x_c for a degenerate edge, e.g. padding).
-
-    Returns:
-        δ (..., C, 2) = p_ic − x_c = t_ic (x_e − x_c) and s² (..., C) = |x_i − p_ic|².
-    """
-    edge = xe - xc
-    rel = xi[..., None, :] - xc
-    t = ((rel * edge).sum(-1) / (edge * edge).sum(-1).clamp_min(1e-12)).clamp(0.0, 1.0)
-    delta = t[..., None] * edge
-    gap = rel - delta
-    return delta, (gap * gap).sum(-1)
-
-
 def _cross_mix(idx: torch.Tensor, w: torch.Tensor, n_r: int) -> tuple[torch.Tensor, torch.Tensor]:
     """Dense cross weights: M_ro (B, N_r, N_o) and M_or (B, N_o, N_r), (M)_ij = Σ_{c: j_c = j} w_ic.
 
@@ -341,28 +304,6 @@ class _LeakyRingMessages(torch.autograd.Function):
 
 
 @dataclass(frozen=True)
-class Candidates:
-    """Soft-kNN candidates of the nodes of a batch in the other graph.
-
-    Attributes:
-        idx: (B, N, C) union indices (robot nodes first).
-        log_phi: (B, N, C) log φ_ic (−∞ for missing candidates).
-        dist2: (B, N, C) the squared distances the weights use: d²_ic to the node, or s²_ic
-            to its outgoing edge (``cross_segments``).
-        delta: (B, N, C, 2) δ_ic = p_ic − x_c (``cross_segments``), else None.
-    """
-
-    idx: torch.Tensor
-    log_phi: torch.Tensor
-    dist2: torch.Tensor
-    delta: torch.Tensor | None = None
-
-    def offset(self, w: torch.Tensor) -> torch.Tensor | None:
-        """(B, N, 2) Σ_c w_ic δ_ic for weights w (B, N, C), or None without segments."""
-        return None if self.delta is None else (w[..., None, :] @ self.delta).squeeze(-2)
-
-
-@dataclass(frozen=True)
 class Union:
     """The union graph G_ro of a batch: N = N_r + N_o nodes (robot nodes first).
 
@@ -403,14 +344,12 @@ class SceneGraph:
         obstacles: (N_o, 2) normalised obstacle node coordinates.
         ring: (2 N,) union index of prev(i) for every node i, then of next(i) (robot first).
         robot_ring: (2 N_r,) the same for the robot graph alone.
-        obstacle_next: (N_o,) index of next(c) among the obstacle nodes.
         fixed: the obstacle graph's features (``two_way=False``), else None.
     """
 
     obstacles: torch.Tensor
     ring: torch.Tensor
     robot_ring: torch.Tensor
-    obstacle_next: torch.Tensor
     fixed: ObstacleFeatures | None = None
 
 
@@ -443,27 +382,19 @@ class GraphDistNet(nn.Module):
         nbr = torch.stack([prev, next, own], -1)
         return Union(x0, nbr, torch.cat([robot.mask, obstacles.mask], 1), n_r)
 
-    def candidates(self, g: Union) -> Candidates:
-        """Soft-kNN candidates of every node in the other graph (C = min(k + 1, size of the
-        larger graph); missing candidates have log φ = −∞), with their edges' closest points
-        when ``cross_segments``."""
+    def candidates(self, g: Union) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Soft-kNN candidates of every node in the other graph.
+
+        Returns:
+            idx (B, N, C) candidate indices into the union, log φ (B, N, C) and d² (B, N, C),
+            C = min(k + 1, size of the larger graph); missing candidates have log φ = −∞.
+        """
         n_r = g.n_robot
         xr, xo = g.x0[:, :n_r], g.x0[:, n_r:]
         d2 = (xr[:, :, None] - xo[:, None]).square().sum(-1)  # (B, N_r, N_o), twice differentiable
         d2 = d2.masked_fill(~g.mask[:, None, n_r:], PAD_DIST2)
         d2 = d2.masked_fill(~g.mask[:, :n_r, None], PAD_DIST2)
-        idx, log_phi, near = nearest_candidates(d2, self.config.cross_k + 1)
-        if not self.config.cross_segments:
-            return Candidates(idx, log_phi, near)
-        b, n, c = idx.shape
-
-        def at(index: torch.Tensor) -> torch.Tensor:
-            flat = index.flatten(1)[..., None].expand(-1, -1, 2)
-            return torch.gather(g.x0, 1, flat).view(b, n, c, 2)
-
-        ends = torch.gather(g.nbr[..., 1], 1, idx.flatten(1)).view(b, n, c)
-        delta, s2 = segment_partners(g.x0, at(idx), at(ends))
-        return Candidates(idx, log_phi, s2, delta)
+        return nearest_candidates(d2, self.config.cross_k + 1)
 
     def partners_argmax(
         self, g: Union, h: torch.Tensor | None, k: int, generator: torch.Generator | None
@@ -489,15 +420,15 @@ class GraphDistNet(nn.Module):
         g: Union,
         h: torch.Tensor | None,
         k: int,
-        cand: Candidates | None,
+        cand: tuple[torch.Tensor, torch.Tensor, torch.Tensor] | None,
         generator: torch.Generator | None,
     ) -> tuple[torch.Tensor, torch.Tensor]:
         """Partners (B, N, C) and weights (B, N, C), Σ_c w = 1, of conv layer k (h = x⁽ᵏ⁾)."""
         if self.config.cross == "argmax":
             idx = self.partners_argmax(g, h, k, generator)[..., None]
             return idx, torch.ones(idx.shape, dtype=g.x0.dtype, device=g.x0.device)
-        idx = cand.idx
-        logits = cand.log_phi - cand.dist2 / self.log_tau[k].exp()
+        idx, log_phi, d2 = cand
+        logits = log_phi - d2 / self.log_tau[k].exp()
         if h is not None:
             score = h @ self.attention[k - 1]  # a⁽ᵏ⁾ scores x⁽ᵏ⁾, k ≥ 1
             logits = logits + torch.gather(score, 1, idx.flatten(1)).view(idx.shape)
@@ -511,7 +442,6 @@ class GraphDistNet(nn.Module):
         idx: torch.Tensor,
         w: torch.Tensor,
         one_way_from: int | None = None,
-        offset: torch.Tensor | None = None,
     ) -> torch.Tensor:
         """First linear layer of h_k on every edge, computed per node.
 
@@ -521,11 +451,9 @@ class GraphDistNet(nn.Module):
             idx, w: (B, N, C) cross partners and weights.
             one_way_from: nodes from this index on (the obstacles) take no cross term
                 (z̄_i = z_i, ``two_way=False``); None: every node takes one.
-            offset: (B, N, 2) Σ_c w_ic δ_ic, the partners' shift from node to closest edge
-                point (``cross_segments``), or None.
 
         Returns:
-            (B, N, 3, H): W_loc (z_j − z_i) + W_rel (Σ_c w_ic z_c + (offset ‖ 0) − z_i) + b.
+            (B, N, 3, H): W_loc (z_j − z_i) + W_rel (Σ_c w_ic z_c − z_i) + b.
         """
         first = self.convs[k][0]
         d = z.shape[-1]
@@ -535,8 +463,6 @@ class GraphDistNet(nn.Module):
         u_j = torch.gather(u, 1, nbr.flatten(1)[..., None].expand(-1, -1, h)).view(b, n, 3, h)
         v_c = torch.gather(v, 1, idx.flatten(1)[..., None].expand(-1, -1, h))
         v_bar = (w[:, :, None] @ v_c.view(b, n, -1, h)).squeeze(2)  # Σ_c w_ic v_c
-        if offset is not None:
-            v_bar = v_bar + offset @ first.weight[:, d : d + 2].T
         if one_way_from is not None:
             v_bar = torch.cat([v_bar[:, :one_way_from], v[:, one_way_from:]], 1)
         return u_j - u[:, :, None] + (v_bar - v + first.bias)[:, :, None]
@@ -569,8 +495,7 @@ class GraphDistNet(nn.Module):
         for k in range(self.config.layers):
             z = g.x0 if h is None else torch.cat([g.x0, h], -1)
             idx, w = self.cross_weights(g, h, k, cand, generator)
-            offset = None if cand is None else cand.offset(w)
-            pre = self.edge_preactivation(k, z, g.nbr, idx, w, one_way, offset)
+            pre = self.edge_preactivation(k, z, g.nbr, idx, w, one_way)
             h = self.convs[k][1:](pre).sum(2) * g.mask[..., None]
             y = self.readout(g, h, k + 1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
@@ -594,7 +519,6 @@ class GraphDistNet(nn.Module):
             xo,
             torch.cat([prev, next]).to(xo.device),
             torch.cat([robot_prev, robot_next]).to(xo.device),
-            obstacles.next[0].to(xo.device),
             None if c.two_way else self.obstacle_features(xo, obstacle_ring),
         )
 
@@ -633,26 +557,19 @@ class GraphDistNet(nn.Module):
         n = x0.shape[1]
         d2 = _pairwise_d2(xr, scene.obstacles)
         idx, log_phi, near = nearest_candidates(d2, c.cross_k + 1)
-        shift = n * torch.arange(b, device=idx.device)[:, None, None]
-        rows = idx + shift  # rows of (B N)
-        delta = None
-        if c.cross_segments:
-            flat = x0.reshape(-1, 2)
-            delta, near = segment_partners(x0, flat[rows], flat[scene.ring[n:][idx] + shift])
+        rows = idx + n * torch.arange(b, device=idx.device)[:, None, None]  # rows of (B N)
         h, score, pooled = None, None, None
         for k in range(c.layers):
             logits = log_phi - near / self.log_tau[k].exp()
             if score is not None:
                 logits = logits + score.flatten()[rows]
             z = x0 if h is None else torch.cat([x0, h], -1)
-            w = _softmax_small(logits)
-            m_ro, m_or = _cross_mix(idx, w, n_r)
+            m_ro, m_or = _cross_mix(idx, _softmax_small(logits), n_r)
 
             def mix(v: torch.Tensor, m_ro=m_ro, m_or=m_or) -> torch.Tensor:
                 return torch.cat([m_ro @ v[:, n_r:], m_or @ v[:, :n_r]], 1)
 
-            offset = Candidates(idx, log_phi, near, delta).offset(w)
-            h = self._lean_conv(k, z, mix, scene.ring, offset)
+            h = self._lean_conv(k, z, mix, scene.ring)
             score = h @ self.attention[k]
             y = torch.cat(
                 [
@@ -671,10 +588,6 @@ class GraphDistNet(nn.Module):
         b, n_o = nodes.shape[0], len(scene.obstacles)
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
         idx, log_phi, near = nearest_obstacle_nodes(xr, scene.obstacles, min(c.cross_k + 1, n_o))
-        delta = None
-        if c.cross_segments:
-            xo = scene.obstacles
-            delta, near = segment_partners(xr, xo[idx], xo[scene.obstacle_next[idx]])
         h, pooled = None, None
         for k in range(c.layers):
             logits = log_phi - near / self.log_tau[k].exp()
@@ -687,8 +600,7 @@ class GraphDistNet(nn.Module):
                 return m_ro @ v_o
 
             z = xr if h is None else torch.cat([xr, h], -1)
-            offset = Candidates(idx, log_phi, near, delta).offset(w)
-            h = self._lean_conv(k, z, mix, scene.robot_ring, offset)
+            h = self._lean_conv(k, z, mix, scene.robot_ring)
             y_r = self._lean_pool(h, h @ self.attention[k])
             y = torch.cat([y_r, fixed.readout[k].expand(b, -1)], -1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
@@ -700,7 +612,6 @@ class GraphDistNet(nn.Module):
         z: torch.Tensor,
         mix: Callable[[torch.Tensor], torch.Tensor],
         ring: torch.Tensor,
-        offset: torch.Tensor | None = None,
     ) -> torch.Tensor:
         """x⁽ᵏ⁺¹⁾ (B, N, d_h): Σ of h_k over the edges (prev, next, self) of every node.
 
@@ -708,7 +619,6 @@ class GraphDistNet(nn.Module):
             z: (B, N, D) node inputs.
             mix: v (B, N, d_h) ↦ v̄ (B, N, d_h), v̄_i = Σ_c w_ic v_c (the cross terms).
             ring: (2 N,) prev and next indices.
-            offset: (B, N, 2) Σ_c w_ic δ_ic (``cross_segments``), or None.
         """
         first, *rest = self.convs[k]  # a list: slicing the Sequential would build a new one
         d = z.shape[-1]
@@ -716,8 +626,6 @@ class GraphDistNet(nn.Module):
         v = z @ first.weight[:, d:].T
         b, n, hd = v.shape
         c = mix(v) - v + first.bias  # (B, N, H), pre-activation of the self edge
-        if offset is not None:
-            c = c + offset @ first.weight[:, d : d + 2].T
         if rest and self.config.activation == "leaky_relu":
             hidden = [m for m in rest[:-1] if isinstance(m, nn.Linear)]
             msg = _LeakyRingMessages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
