@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import gdnplan as gp
+from gdnplan import trajopt
 from gdnplan.ccd import certify_path, lever_arms, motion_bound, verify_path
 from gdnplan.models import CoalModel
 from gdnplan.trajopt import (
@@ -303,3 +304,34 @@ def test_each_restart_adds_a_check_point_per_segment(square):
     assert not result.success and result.attempts == 3
     batches = list(dict.fromkeys(model.sizes))  # distinct NLP sizes, in order
     assert batches[:3] == [(p.waypoints - 1) * (m + 1) - 1 for m in (2, 3, 4)]
+
+
+def test_check_point_raise_follows_the_segments_near_the_rejected_ones():
+    splits = np.array([2, 4, 2, 2, 2])  # inner check points at t + i / n_t, 0 < s < 5
+    raised = np.zeros(5)
+    raised[trajopt._near_segments([3], 5, 1)] += 0.1  # segments 2, 3, 4
+    s = trajopt._path_parameters(splits)[1:-1]
+    expected = np.where(s >= 2.0, 0.1, 0.0)  # waypoint 2 takes the larger of segments 1 and 2
+    np.testing.assert_allclose(trajopt._check_point_raise(splits, raised), expected)
+    assert trajopt._near_segments([0, 4], 5, 0).tolist() == [True, False, False, False, True]
+
+
+def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monkeypatch):
+    margins = []
+    original = trajopt._Transcription.__init__
+
+    def record(self, problem, model, goal, opts, splits, margin, warm=False):
+        margins.append((splits.copy(), np.broadcast_to(margin, (int(splits.sum()) - 1,)).copy()))
+        original(self, problem, model, goal, opts, splits, margin, warm)
+
+    monkeypatch.setattr(trajopt._Transcription, "__init__", record)
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
+    opts = TrajoptOptions(initial="rrt", refine_rounds=1, starts=1, raise_window=1)
+    assert not plan(p, collision=_Liar(), options=opts).success
+    (_, first), (splits, second) = margins
+    assert np.all(first == p.margin)
+    refined = np.flatnonzero(splits > splits.min())  # the segments coal rejected
+    near = trajopt._near_segments(list(refined), len(splits), 1)
+    expected_raised = trajopt._check_point_raise(splits, near.astype(float)) > 0
+    assert (second > p.margin).tolist() == expected_raised.tolist()
+    assert 0 < expected_raised.sum() < len(second)  # some check points keep the plain margin
