@@ -334,9 +334,6 @@ def train(
     order = np.random.default_rng(seed).permutation(len(full))
     n_val = max(len(full) // 10, 1)
     extra_sets = [load(path) for path in extra]
-    for path, ds in zip(extra, extra_sets, strict=True):
-        if ds.env != env:
-            raise InputError(f"extra: {path} holds samples of env {ds.env!r}, not {env!r}")
     train_t = tensors(concat([full.subset(order[n_val:]), *extra_sets]), config)
     val_t = tensors(full.subset(order[:n_val]), config)
     net = GraphDistNet(config).to(device)

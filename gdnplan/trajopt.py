@@ -557,6 +557,9 @@ def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, 
     (the path slipped through an obstacle between them), a second attempt with 3 succeeded.
     """
     first = _interpolated(opts, IPOPT_INTERPOLATED)  # bad input fails even on a free line
+    window = opts.raise_window
+    if window is not None and (not isinstance(window, int) or window < 0):
+        raise InputError(f"raise_window: expected an integer ≥ 0 or None, got {window!r}")
     line = straight_line(problem.start, goal, problem.waypoints)
     if opts.initial == "auto" and _line_free(problem, line):
         status = "straight line certified free (optimal path cost, no solve needed)"

@@ -275,13 +275,15 @@ def test_check_points_per_segment_follow_the_solver_default(square, solver, inte
 
 
 @pytest.mark.parametrize("initial", ["rrt", "auto"])
-def test_negative_interpolated_raises(square, initial):
+def test_negative_interpolated_or_raise_window_raises(square, initial):
     goal = [1.3, -2.5] if initial == "auto" else GOAL  # auto: a free straight line, no solve
     p = Problem(scene=square, start=START, goal=goal, waypoints=10)
     if initial == "auto":
         assert plan(p, collision="coal").status.startswith("straight line certified free")
     with pytest.raises(gp.GdnplanError, match="interpolated"):
         plan(p, collision="coal", options=TrajoptOptions(interpolated=-1, initial=initial))
+    with pytest.raises(gp.GdnplanError, match="raise_window"):
+        plan(p, collision="coal", options=TrajoptOptions(raise_window=-1, initial=initial))
 
 
 class _Liar(_BatchSizes):
