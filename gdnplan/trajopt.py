@@ -557,9 +557,8 @@ def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, 
     (the path slipped through an obstacle between them), a second attempt with 3 succeeded.
     """
     first = _interpolated(opts, IPOPT_INTERPOLATED)  # bad input fails even on a free line
-    window = opts.raise_window
-    if window is not None and (not isinstance(window, int) or window < 0):
-        raise InputError(f"raise_window: expected an integer ≥ 0 or None, got {window!r}")
+    if opts.raise_window is not None:
+        _count(opts.raise_window, "raise_window")
     line = straight_line(problem.start, goal, problem.waypoints)
     if opts.initial == "auto" and _line_free(problem, line):
         status = "straight line certified free (optimal path cost, no solve needed)"
@@ -601,7 +600,7 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
     per_link = supports_per_link(model) if opts.per_link is None else opts.per_link
     learned = not isinstance(model, CoalModel)
     margin = problem.margin + (opts.learned_margin if learned else 0.0)
-    raised = np.zeros(len(splits))  # margin raise of each segment (m), raise_window only
+    raised = np.zeros(len(splits))  # margin raise of each segment (m)
     q, duals = guess, None
     for _ in range(1 + (opts.refine_rounds if opts.ccd else 0)):
         nlp = _Transcription(
@@ -631,15 +630,15 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         splits = refined
         if learned:
             over = model_overestimate(problem.scene, model, q, bad, problem.margin)
-            if opts.raise_window is None:
-                margin += over
-            else:
-                raised[_near_segments(bad, len(splits), opts.raise_window)] += over
+            raised[_near_segments(bad, len(splits), opts.raise_window)] += over
     return q, stats, False
 
 
-def _near_segments(bad: list[int], n: int, window: int) -> np.ndarray:
-    """(n,) bool: the segments ``bad`` and ``window`` segments either side of each."""
+def _near_segments(bad: list[int], n: int, window: int | None) -> np.ndarray:
+    """(n,) bool: the segments ``bad`` and ``window`` segments either side of each (all n
+    segments when window is None)."""
+    if window is None:
+        return np.ones(n, bool)
     near = np.zeros(n, bool)
     for t in bad:
         near[max(t - window, 0) : t + window + 1] = True
@@ -657,10 +656,14 @@ def _check_point_raise(splits: np.ndarray, raised: np.ndarray) -> np.ndarray:
 
 def _interpolated(opts: TrajoptOptions, default: int) -> int:
     """Check points strictly inside each segment: ``opts.interpolated`` or the solver's default."""
-    m = default if opts.interpolated is None else opts.interpolated
-    if not isinstance(m, int) or m < 0:
-        raise InputError(f"interpolated: expected an integer ≥ 0 or None, got {m!r}")
-    return m
+    return _count(default if opts.interpolated is None else opts.interpolated, "interpolated")
+
+
+def _count(value, name: str) -> int:
+    """``value`` if it is an integer ≥ 0, else InputError naming the option."""
+    if not isinstance(value, int) or value < 0:
+        raise InputError(f"{name}: expected an integer ≥ 0 or None, got {value!r}")
+    return value
 
 
 def model_overestimate(

@@ -316,6 +316,7 @@ def test_check_point_raise_follows_the_segments_near_the_rejected_ones():
     expected = np.where(s >= 2.0, 0.1, 0.0)  # waypoint 2 takes the larger of segments 1 and 2
     np.testing.assert_allclose(trajopt._check_point_raise(splits, raised), expected)
     assert trajopt._near_segments([0, 4], 5, 0).tolist() == [True, False, False, False, True]
+    assert trajopt._near_segments([2], 5, None).all()  # raise_window=None: the whole path
 
 
 def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monkeypatch):
