@@ -248,11 +248,18 @@ def _load_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam) -> di
 
 
 def _load_init(net: GraphDistNet, path: Path) -> None:
-    """Load the weights at ``path`` into ``net``; InputError if missing or of another shape."""
+    """Load the weights at ``path`` into ``net``; InputError if missing or of another shape.
+
+    Weights without the ``node_distance`` input (w_k) start a ``node_distance`` network at
+    w_k = 0, the function of the loaded network, which then learns to use s_i.
+    """
     if not path.exists():
         raise InputError(f"--init: {path} does not exist")
+    state = load_file(str(path))
+    if net.config.node_distance and "distance_in" not in state:
+        state["distance_in"] = torch.zeros_like(net.distance_in)
     try:
-        net.load_state_dict(load_file(str(path)))
+        net.load_state_dict(state)
     except RuntimeError as e:
         raise InputError(f"--init: {path} does not fit this architecture ({e})") from e
 

@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from shapely.geometry import Point, Polygon
 
 import gdnplan as gp
 from gdnplan.data import load
@@ -17,6 +18,7 @@ from gdnplan.models.graphdistnet import (
     _repeat,
     nearest_columns,
     nearest_obstacle_nodes,
+    signed_ring_distance,
 )
 from gdnplan.train import distance_loss, evaluate
 
@@ -42,7 +44,14 @@ def random_model(env: str, dtype=torch.float32, **changes) -> tuple[gp.Scene, Gr
 
 
 @pytest.mark.parametrize(
-    "changes", [{}, {"activation": "silu", "max_edge": 0.25}, {"two_way": False}]
+    "changes",
+    [
+        {},
+        {"activation": "silu", "max_edge": 0.25},
+        {"two_way": False},
+        {"node_distance": True},
+        {"node_distance": True, "two_way": False},
+    ],
 )
 def test_autograd_gradient_matches_finite_differences(changes):
     scene, model = random_model("e", torch.float64, **changes)
@@ -91,6 +100,23 @@ def test_permuting_obstacles_and_start_vertices_keeps_distance():
     shuffled = [np.roll(scene.obstacles[i], rng.integers(1, 5), 0) for i in rng.permutation(5)]
     d = model.distance(scene, q)
     np.testing.assert_allclose(model.distance(scene.with_obstacles(shuffled), q), d, atol=1e-5)
+
+
+@pytest.mark.parametrize("env", ["d", "e"])  # overlapping squares; non-convex α-shapes
+def test_signed_ring_distance_matches_shapely(env):
+    scene = gp.make_scene(env, seed=4)
+    graph = obstacle_graph(*scene_obstacles([scene]), dtype=torch.float64)
+    rng = np.random.default_rng(0)
+    lo, hi = graph.nodes[0].min(0).values.numpy(), graph.nodes[0].max(0).values.numpy()
+    points = rng.uniform(lo - 0.1, hi + 0.1, (400, 2))
+    s = signed_ring_distance(torch.tensor(points)[None], graph.nodes, graph.next, graph.mask)[0]
+    polygons = [Polygon(p) for p in scene.obstacles]
+    for x, got in zip(points, s.numpy(), strict=True):
+        pt = Point(x)
+        edge = min(p.exterior.distance(pt) for p in polygons)
+        inside = any(p.contains(pt) for p in polygons)
+        assert got == pytest.approx(-edge if inside else edge, abs=1e-9)
+    assert (s < 0).any() and (s > 0).any()
 
 
 def test_lean_first_layer_equals_naive_per_edge_reference():
@@ -151,6 +177,8 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("d", {"mlp": ()}),
     ("d", {"two_way": False}),  # obstacle features cached per scene
     ("a", {"two_way": False, "activation": "silu"}),  # fewer obstacle nodes than candidates
+    ("c", {"node_distance": True}),
+    ("d", {"node_distance": True, "two_way": False}),
 ]
 
 
@@ -251,3 +279,20 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig.from_dict({"layers": 2, "width": 3})
     with pytest.raises(gp.InputError):
         gp.load_model(WEIGHTS / "nonexistent.safetensors")
+
+
+def test_node_distance_warm_start_keeps_the_loaded_function(tmp_path):
+    from safetensors.torch import save_file
+
+    from gdnplan.train import _load_init
+
+    scene, old = random_model("c")
+    path = tmp_path / "old.safetensors"
+    save_file(old.net.state_dict(), str(path))
+    new = GraphDistNet(old.config.with_(node_distance=True))
+    _load_init(new, path)
+    q = scene.robot.sample(20, seed=1)
+    np.testing.assert_array_equal(GraphDistNetModel(new).distance(scene, q), old.distance(scene, q))
+    assert not torch.any(new.distance_in)
+    new.distance_in.data.fill_(0.5)  # the feature then changes d̂
+    assert np.abs(GraphDistNetModel(new).distance(scene, q) - old.distance(scene, q)).max() > 1e-4

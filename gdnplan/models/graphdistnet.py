@@ -90,6 +90,9 @@ class GraphDistNetConfig:
         contact_weight: extra weight μ of samples near contact in the distance loss,
             w = 1 + μ · exp(−|f| / contact_scale) (0 = paper: every sample alike).
         contact_scale: distance (m) over which the contact weight decays.
+        node_distance: distance-aware nodes (beyond the paper): every layer's h_k also takes
+            s_i, node i's signed distance to the other graph's polygons (normalised units,
+            negative inside), as an absolute input (module docstring).
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
     """
@@ -107,6 +110,7 @@ class GraphDistNetConfig:
     grad_weight: float = 0.0
     contact_weight: float = 0.0
     contact_scale: float = 0.02
+    node_distance: bool = False
     scale: float = 1.0
     origin: tuple[float, float] = (0.0, 0.0)
 
@@ -246,6 +250,41 @@ def _pairwise_d2(xr: torch.Tensor, xo: torch.Tensor) -> torch.Tensor:
     return dx * dx + dy * dy
 
 
+def signed_ring_distance(
+    points: torch.Tensor, nodes: torch.Tensor, next: torch.Tensor, mask: torch.Tensor
+) -> torch.Tensor:
+    """Signed distance (B, P) of points (B, P, 2) to the union of counter-clockwise rings.
+
+    Rings: nodes (B, M, 2) (or (1, M, 2), shared), next (B, M) and mask (B, M); edge m runs
+    from a_m to b_m = a_next(m). The distance is to the nearest edge,
+
+        δ_pm = |p − a_m − t e_m|,  e_m = b_m − a_m,  t = clamp((p − a_m)·e_m / |e_m|², 0, 1),
+
+    s_p = ± min_m δ_pm, negative where p is inside a ring (non-zero winding number: edges
+    crossing the ray p + λ x̂, λ > 0, counted +1 upwards with p on their left, −1 downwards
+    with p on their right). s is continuous in p and in the nodes (the sign switches where
+    min δ = 0); masked edges are left out. Between two apart polygons the distance is the
+    smallest |s| over the vertices of both, since a closest pair has a vertex at one end.
+    """
+    ends = torch.gather(nodes, 1, next[..., None].expand(*next.shape, 2))
+    e = (ends - nodes)[:, None]  # (B, 1, M, 2)
+    w = points[:, :, None] - nodes[:, None]  # (B, P, M, 2)
+    t = ((w * e).sum(-1) / (e * e).sum(-1).clamp_min(1e-12)).clamp(0.0, 1.0)
+    r = w - t[..., None] * e
+    d2 = (r * r).sum(-1).masked_fill(~mask[:, None], PAD_DIST2)
+    dist = d2.amin(-1).clamp_min(1e-12).sqrt()
+    with torch.no_grad():
+        wy, ey = w[..., 1], e[..., 1]
+        left = e[..., 0] * wy - ey * w[..., 0]  # e × (p − a) > 0: p left of the edge
+        up = (wy >= 0) & (wy < ey)  # a_y ≤ p_y < b_y
+        down = (wy < 0) & (wy >= ey)  # b_y ≤ p_y < a_y
+        winding = ((up & (left > 0)).int() - (down & (left < 0)).int()).masked_fill(
+            ~mask[:, None], 0
+        )
+        inside = winding.sum(-1) != 0
+    return torch.where(inside, -dist, dist)
+
+
 def _cross_mix(idx: torch.Tensor, w: torch.Tensor, n_r: int) -> tuple[torch.Tensor, torch.Tensor]:
     """Dense cross weights: M_ro (B, N_r, N_o) and M_or (B, N_o, N_r), (M)_ij = Σ_{c: j_c = j} w_ic.
 
@@ -368,6 +407,9 @@ class GraphDistNet(nn.Module):
         self.log_tau = nn.Parameter(torch.full((c.layers,), math.log(c.tau)))
         self.head = mlp([2 * c.hidden, *c.readout, 1], c.activation)
         self.out_act = _activation(c.activation)
+        if c.node_distance:  # w_k: s_i w_k joins the first linear layer of h_k on every edge
+            width = (c.mlp or (c.hidden,))[0]
+            self.distance_in = nn.Parameter(torch.empty(c.layers, width).uniform_(-1.0, 1.0))
 
     # ------------------------------------------------------------------ graph plumbing
     def union(self, robot: GraphBatch, obstacles: GraphBatch) -> Union:
@@ -395,6 +437,22 @@ class GraphDistNet(nn.Module):
         d2 = d2.masked_fill(~g.mask[:, None, n_r:], PAD_DIST2)
         d2 = d2.masked_fill(~g.mask[:, :n_r, None], PAD_DIST2)
         return nearest_candidates(d2, self.config.cross_k + 1)
+
+    def node_distances(self, g: Union) -> torch.Tensor | None:
+        """(B, N) s_i of ``node_distance`` networks (:func:`signed_ring_distance`, normalised
+        units; robot nodes to the obstacle polygons, obstacle nodes to the link polygons, 0 on
+        padding and, for one-way networks, on obstacle nodes); None for other networks."""
+        if not self.config.node_distance:
+            return None
+        n_r = g.n_robot
+        nxt = g.nbr[..., 1]
+        xr, xo = g.x0[:, :n_r], g.x0[:, n_r:]
+        s_r = signed_ring_distance(xr, xo, nxt[:, n_r:] - n_r, g.mask[:, n_r:])
+        if self.config.two_way:
+            s_o = signed_ring_distance(xo, xr, nxt[:, :n_r], g.mask[:, :n_r])
+        else:
+            s_o = xo.new_zeros(xo.shape[:2])
+        return torch.cat([s_r, s_o], 1) * g.mask
 
     def partners_argmax(
         self, g: Union, h: torch.Tensor | None, k: int, generator: torch.Generator | None
@@ -442,6 +500,7 @@ class GraphDistNet(nn.Module):
         idx: torch.Tensor,
         w: torch.Tensor,
         one_way_from: int | None = None,
+        s: torch.Tensor | None = None,
     ) -> torch.Tensor:
         """First linear layer of h_k on every edge, computed per node.
 
@@ -451,9 +510,10 @@ class GraphDistNet(nn.Module):
             idx, w: (B, N, C) cross partners and weights.
             one_way_from: nodes from this index on (the obstacles) take no cross term
                 (z̄_i = z_i, ``two_way=False``); None: every node takes one.
+            s: (B, N) node distances s_i (``node_distance``), or None.
 
         Returns:
-            (B, N, 3, H): W_loc (z_j − z_i) + W_rel (Σ_c w_ic z_c − z_i) + b.
+            (B, N, 3, H): W_loc (z_j − z_i) + W_rel (Σ_c w_ic z_c − z_i) + s_i w_k + b.
         """
         first = self.convs[k][0]
         d = z.shape[-1]
@@ -465,7 +525,11 @@ class GraphDistNet(nn.Module):
         v_bar = (w[:, :, None] @ v_c.view(b, n, -1, h)).squeeze(2)  # Σ_c w_ic v_c
         if one_way_from is not None:
             v_bar = torch.cat([v_bar[:, :one_way_from], v[:, one_way_from:]], 1)
-        return u_j - u[:, :, None] + (v_bar - v + first.bias)[:, :, None]
+        return u_j - u[:, :, None] + self._node_term(k, v_bar - v + first.bias, s)[:, :, None]
+
+    def _node_term(self, k: int, c: torch.Tensor, s: torch.Tensor | None) -> torch.Tensor:
+        """c (B, N, H) + s_i w_k (``node_distance``; s (B, N)), or c when s is None."""
+        return c if s is None else torch.addcmul(c, s[..., None], self.distance_in[k])
 
     def readout(self, g: Union, h: torch.Tensor, k: int) -> torch.Tensor:
         """(B, 2 d_h): f(Σ α_i x_i⁽ᵏ⁾) for the robot graph, then the obstacle graph (k ≥ 1)."""
@@ -490,12 +554,13 @@ class GraphDistNet(nn.Module):
         g = self.union(robot, obstacles)
         cand = self.candidates(g) if self.config.cross == "soft_knn" else None
         one_way = None if self.config.two_way else g.n_robot
+        s = self.node_distances(g)
         h = None
         pooled = None
         for k in range(self.config.layers):
             z = g.x0 if h is None else torch.cat([g.x0, h], -1)
             idx, w = self.cross_weights(g, h, k, cand, generator)
-            pre = self.edge_preactivation(k, z, g.nbr, idx, w, one_way)
+            pre = self.edge_preactivation(k, z, g.nbr, idx, w, one_way, s)
             h = self.convs[k][1:](pre).sum(2) * g.mask[..., None]
             y = self.readout(g, h, k + 1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
@@ -557,6 +622,7 @@ class GraphDistNet(nn.Module):
         n = x0.shape[1]
         d2 = _pairwise_d2(xr, scene.obstacles)
         idx, log_phi, near = nearest_candidates(d2, c.cross_k + 1)
+        s = self._lean_distances(xr, scene, two_way=True)
         rows = idx + n * torch.arange(b, device=idx.device)[:, None, None]  # rows of (B N)
         h, score, pooled = None, None, None
         for k in range(c.layers):
@@ -569,7 +635,7 @@ class GraphDistNet(nn.Module):
             def mix(v: torch.Tensor, m_ro=m_ro, m_or=m_or) -> torch.Tensor:
                 return torch.cat([m_ro @ v[:, n_r:], m_or @ v[:, :n_r]], 1)
 
-            h = self._lean_conv(k, z, mix, scene.ring)
+            h = self._lean_conv(k, z, mix, scene.ring, s)
             score = h @ self.attention[k]
             y = torch.cat(
                 [
@@ -588,6 +654,7 @@ class GraphDistNet(nn.Module):
         b, n_o = nodes.shape[0], len(scene.obstacles)
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
         idx, log_phi, near = nearest_obstacle_nodes(xr, scene.obstacles, min(c.cross_k + 1, n_o))
+        s = self._lean_distances(xr, scene, two_way=False)
         h, pooled = None, None
         for k in range(c.layers):
             logits = log_phi - near / self.log_tau[k].exp()
@@ -600,7 +667,7 @@ class GraphDistNet(nn.Module):
                 return m_ro @ v_o
 
             z = xr if h is None else torch.cat([xr, h], -1)
-            h = self._lean_conv(k, z, mix, scene.robot_ring)
+            h = self._lean_conv(k, z, mix, scene.robot_ring, s)
             y_r = self._lean_pool(h, h @ self.attention[k])
             y = torch.cat([y_r, fixed.readout[k].expand(b, -1)], -1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
@@ -612,6 +679,7 @@ class GraphDistNet(nn.Module):
         z: torch.Tensor,
         mix: Callable[[torch.Tensor], torch.Tensor],
         ring: torch.Tensor,
+        s: torch.Tensor | None = None,
     ) -> torch.Tensor:
         """x⁽ᵏ⁺¹⁾ (B, N, d_h): Σ of h_k over the edges (prev, next, self) of every node.
 
@@ -619,13 +687,14 @@ class GraphDistNet(nn.Module):
             z: (B, N, D) node inputs.
             mix: v (B, N, d_h) ↦ v̄ (B, N, d_h), v̄_i = Σ_c w_ic v_c (the cross terms).
             ring: (2 N,) prev and next indices.
+            s: (B, N) node distances (``node_distance``), or None.
         """
         first, *rest = self.convs[k]  # a list: slicing the Sequential would build a new one
         d = z.shape[-1]
         u = z @ first.weight[:, :d].T  # (B, N, H)
         v = z @ first.weight[:, d:].T
         b, n, hd = v.shape
-        c = mix(v) - v + first.bias  # (B, N, H), pre-activation of the self edge
+        c = self._node_term(k, mix(v) - v + first.bias, s)  # (B, N, H): the self edge
         if rest and self.config.activation == "leaky_relu":
             hidden = [m for m in rest[:-1] if isinstance(m, nn.Linear)]
             msg = _LeakyRingMessages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
@@ -639,6 +708,26 @@ class GraphDistNet(nn.Module):
             msg = pre.sum(1)
         last = rest[-1]
         return nn.functional.linear(msg, last.weight, 3 * last.bias)
+
+    def _lean_distances(
+        self, xr: torch.Tensor, scene: SceneGraph, two_way: bool
+    ) -> torch.Tensor | None:
+        """:meth:`node_distances` of normalised robot nodes xr (B, N_r, 2) in ``scene``: (B, N)
+        robot then obstacle nodes (two-way), (B, N_r) robot nodes (one-way); None for networks
+        without ``node_distance``."""
+        if not self.config.node_distance:
+            return None
+        b, n_r, _ = xr.shape
+        xo = scene.obstacles[None]
+        n = n_r + xo.shape[1]
+        robot_next = scene.robot_ring[n_r:][None].expand(b, -1)
+        obstacle_next = scene.ring[n + n_r :][None] - n_r
+        ones = torch.ones(1, 1, dtype=torch.bool, device=xr.device)
+        s_r = signed_ring_distance(xr, xo, obstacle_next, ones.expand(1, xo.shape[1]))
+        if not two_way:
+            return s_r
+        s_o = signed_ring_distance(xo.expand(b, -1, -1), xr, robot_next, ones.expand(b, n_r))
+        return torch.cat([s_r, s_o], 1)
 
     def _lean_pool(self, h: torch.Tensor, score: torch.Tensor) -> torch.Tensor:
         """(B, d_h): f(Σ_i α_i x_i), α = softmax(score) over the nodes of h (B, n, d_h)."""
