@@ -50,7 +50,8 @@ def random_model(env: str, dtype=torch.float32, **changes) -> tuple[gp.Scene, Gr
         {"activation": "silu", "max_edge": 0.25},
         {"two_way": False},
         {"node_distance": True},
-        {"node_distance": True, "two_way": False},
+        {"node_distance": True, "two_way": False, "min_readout": True},
+        {"node_distance": True, "min_readout": True, "tau_min": 0.02},
     ],
 )
 def test_autograd_gradient_matches_finite_differences(changes):
@@ -179,6 +180,8 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("a", {"two_way": False, "activation": "silu"}),  # fewer obstacle nodes than candidates
     ("c", {"node_distance": True}),
     ("d", {"node_distance": True, "two_way": False}),
+    ("e", {"node_distance": True, "two_way": False, "min_readout": True}),
+    ("b", {"node_distance": True, "min_readout": True}),
 ]
 
 
@@ -275,6 +278,10 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig(activation="relu")
     with pytest.raises(gp.InputError):
         GraphDistNetConfig(contact_weight=-1.0)
+    with pytest.raises(gp.InputError, match="min_readout needs node_distance"):
+        GraphDistNetConfig(min_readout=True)
+    with pytest.raises(gp.InputError, match="tau_min"):
+        GraphDistNetConfig(node_distance=True, min_readout=True, tau_min=0.0)
     with pytest.raises(gp.InputError):
         GraphDistNetConfig.from_dict({"layers": 2, "width": 3})
     with pytest.raises(gp.InputError):
@@ -289,10 +296,10 @@ def test_node_distance_warm_start_keeps_the_loaded_function(tmp_path):
     scene, old = random_model("c")
     path = tmp_path / "old.safetensors"
     save_file(old.net.state_dict(), str(path))
-    new = GraphDistNet(old.config.with_(node_distance=True))
+    new = GraphDistNet(old.config.with_(node_distance=True, min_readout=True))
     _load_init(new, path)
     q = scene.robot.sample(20, seed=1)
     np.testing.assert_array_equal(GraphDistNetModel(new).distance(scene, q), old.distance(scene, q))
-    assert not torch.any(new.distance_in)
+    assert not torch.any(new.distance_in) and not torch.any(new.head[0].weight[:, -1])
     new.distance_in.data.fill_(0.5)  # the feature then changes d̂
     assert np.abs(GraphDistNetModel(new).distance(scene, q) - old.distance(scene, q)).max() > 1e-4

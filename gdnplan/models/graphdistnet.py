@@ -93,6 +93,10 @@ class GraphDistNetConfig:
         node_distance: distance-aware nodes (beyond the paper): every layer's h_k also takes
             s_i, node i's signed distance to the other graph's polygons (normalised units,
             negative inside), as an absolute input (module docstring).
+        min_readout: the readout MLP also takes the soft minimum of the node distances,
+            m = −τ_m log Σ_i exp(−s_i / τ_m) (τ_m learned, initially ``tau_min``); needs
+            ``node_distance``. Between apart polygons min_i s_i is the distance itself.
+        tau_min: initial τ_m (normalised units).
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
     """
@@ -111,6 +115,8 @@ class GraphDistNetConfig:
     contact_weight: float = 0.0
     contact_scale: float = 0.02
     node_distance: bool = False
+    min_readout: bool = False
+    tau_min: float = 1e-3
     scale: float = 1.0
     origin: tuple[float, float] = (0.0, 0.0)
 
@@ -125,6 +131,10 @@ class GraphDistNetConfig:
             raise InputError("layers, hidden, cross_k and scale must be positive")
         if self.contact_weight < 0 or self.contact_scale <= 0:
             raise InputError("contact_weight must be ≥ 0 and contact_scale positive")
+        if self.min_readout and not self.node_distance:
+            raise InputError("min_readout needs node_distance=True (it reads the node distances)")
+        if self.tau_min <= 0:
+            raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
 
     @classmethod
     def faithful(cls, **changes) -> GraphDistNetConfig:
@@ -405,11 +415,13 @@ class GraphDistNet(nn.Module):
             self.convs.append(mlp([2 * d_in, *c.mlp, c.hidden], c.activation))
         self.attention = nn.Parameter(torch.randn(c.layers, c.hidden) / math.sqrt(c.hidden))
         self.log_tau = nn.Parameter(torch.full((c.layers,), math.log(c.tau)))
-        self.head = mlp([2 * c.hidden, *c.readout, 1], c.activation)
+        self.head = mlp([2 * c.hidden + c.min_readout, *c.readout, 1], c.activation)
         self.out_act = _activation(c.activation)
         if c.node_distance:  # w_k: s_i w_k joins the first linear layer of h_k on every edge
             width = (c.mlp or (c.hidden,))[0]
             self.distance_in = nn.Parameter(torch.empty(c.layers, width).uniform_(-1.0, 1.0))
+        if c.min_readout:
+            self.log_tau_min = nn.Parameter(torch.tensor(math.log(c.tau_min)))
 
     # ------------------------------------------------------------------ graph plumbing
     def union(self, robot: GraphBatch, obstacles: GraphBatch) -> Union:
@@ -564,6 +576,23 @@ class GraphDistNet(nn.Module):
             h = self.convs[k][1:](pre).sum(2) * g.mask[..., None]
             y = self.readout(g, h, k + 1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
+        if one_way is not None and s is not None:
+            return self.estimate(pooled, s[:, :one_way], g.mask[:, :one_way])
+        return self.estimate(pooled, s, g.mask)
+
+    def estimate(
+        self, pooled: torch.Tensor, s: torch.Tensor | None, mask: torch.Tensor | None = None
+    ) -> torch.Tensor:
+        """d̂ (B,) (m) = scale · MLP(y_r ‖ y_o [‖ m]) of the pooled readouts (B, 2 d_h) and, with
+        ``min_readout``, the soft minimum m of the node distances s (B, N) over ``mask``
+        (B, N) (None: all nodes). One-way networks pass the robot nodes only (obstacle nodes
+        have no s_i)."""
+        if self.config.min_readout:
+            tau = self.log_tau_min.exp()
+            logits = -s / tau
+            if mask is not None:
+                logits = logits.masked_fill(~mask, -math.inf)
+            pooled = torch.cat([pooled, -tau * torch.logsumexp(logits, -1, keepdim=True)], -1)
         return self.head(pooled).squeeze(-1) * self.config.scale
 
     # ------------------------------------------------------------------ lean inference
@@ -645,7 +674,7 @@ class GraphDistNet(nn.Module):
                 -1,
             )
             pooled = y if pooled is None else torch.maximum(pooled, y)
-        return self.head(pooled).squeeze(-1) * c.scale
+        return self.estimate(pooled, s)
 
     def lean_one_way(self, nodes: torch.Tensor, scene: SceneGraph) -> torch.Tensor:
         """:meth:`lean` for ``two_way=False``: only the robot graph runs per configuration;
@@ -671,7 +700,7 @@ class GraphDistNet(nn.Module):
             y_r = self._lean_pool(h, h @ self.attention[k])
             y = torch.cat([y_r, fixed.readout[k].expand(b, -1)], -1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
-        return self.head(pooled).squeeze(-1) * c.scale
+        return self.estimate(pooled, s)
 
     def _lean_conv(
         self,
