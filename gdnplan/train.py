@@ -250,19 +250,14 @@ def _load_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam) -> di
 def _load_init(net: GraphDistNet, path: Path) -> None:
     """Load the weights at ``path`` into ``net``; InputError if missing or of another shape.
 
-    Weights without the ``node_distance`` input w_k or the ``min_readout`` input m start such
-    a network as the function of the loaded one (w_k = 0, a zero column for m in the readout
-    MLP's first layer, τ_m at its initial value); it then learns to use them.
+    Weights without the ``node_distance`` input w_k start a ``node_distance`` network at
+    w_k = 0, the function of the loaded network, which then learns to use s_i.
     """
     if not path.exists():
         raise InputError(f"--init: {path} does not exist")
     state = load_file(str(path))
     if net.config.node_distance and "distance_in" not in state:
         state["distance_in"] = torch.zeros_like(net.distance_in)
-    if net.config.min_readout and "log_tau_min" not in state:
-        state["log_tau_min"] = net.log_tau_min.detach().clone()
-        first = state["head.0.weight"]
-        state["head.0.weight"] = torch.cat([first, first.new_zeros(len(first), 1)], 1)
     try:
         net.load_state_dict(state)
     except RuntimeError as e:

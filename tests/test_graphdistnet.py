@@ -36,11 +36,16 @@ SHIPPED = {  # env: (max MAE m, min AUC, max ACD); measured: see benchmarks/RESU
 }
 
 
-def random_model(env: str, dtype=torch.float32, **changes) -> tuple[gp.Scene, GraphDistNetModel]:
+def random_model(
+    env: str, dtype=torch.float32, keep_init: bool = False, **changes
+) -> tuple[gp.Scene, GraphDistNetModel]:
     scene = gp.make_scene(env, seed=5)
     torch.manual_seed(0)
     config = GraphDistNetConfig.smooth(scale=scene.robot.reach, **changes)
-    return scene, GraphDistNetModel(GraphDistNet(config), dtype=dtype)
+    net = GraphDistNet(config)
+    if config.min_readout and not keep_init:  # a readout MLP that is not yet zero
+        torch.nn.init.normal_(net.head[-1].weight, std=0.3)
+    return scene, GraphDistNetModel(net, dtype=dtype)
 
 
 @pytest.mark.parametrize(
@@ -296,10 +301,25 @@ def test_node_distance_warm_start_keeps_the_loaded_function(tmp_path):
     scene, old = random_model("c")
     path = tmp_path / "old.safetensors"
     save_file(old.net.state_dict(), str(path))
-    new = GraphDistNet(old.config.with_(node_distance=True, min_readout=True))
+    new = GraphDistNet(old.config.with_(node_distance=True))
     _load_init(new, path)
     q = scene.robot.sample(20, seed=1)
     np.testing.assert_array_equal(GraphDistNetModel(new).distance(scene, q), old.distance(scene, q))
-    assert not torch.any(new.distance_in) and not torch.any(new.head[0].weight[:, -1])
+    assert not torch.any(new.distance_in)
     new.distance_in.data.fill_(0.5)  # the feature then changes d̂
     assert np.abs(GraphDistNetModel(new).distance(scene, q) - old.distance(scene, q)).max() > 1e-4
+    with pytest.raises(gp.InputError, match="does not fit"):  # another readout MLP
+        _load_init(GraphDistNet(new.config.with_(min_readout=True)), path)
+
+
+def test_min_readout_starts_at_the_soft_minimum_of_node_distances():
+    """An untrained min_readout network is m: between apart polygons about coal's distance."""
+    scene, model = random_model(
+        "c", torch.float64, keep_init=True, node_distance=True, min_readout=True
+    )
+    q = scene.robot.sample(300, seed=2)
+    d = gp.CoalModel().distance(scene, q)
+    free = d > 0.05
+    err = np.abs(model.distance(scene, q) - d)[free]
+    tau = model.config.tau_min * model.config.scale
+    assert free.sum() > 50 and err.max() < tau * np.log(60)  # soft-min bias ≤ τ log N

@@ -93,9 +93,11 @@ class GraphDistNetConfig:
         node_distance: distance-aware nodes (beyond the paper): every layer's h_k also takes
             s_i, node i's signed distance to the other graph's polygons (normalised units,
             negative inside), as an absolute input (module docstring).
-        min_readout: the readout MLP also takes the soft minimum of the node distances,
-            m = −τ_m log Σ_i exp(−s_i / τ_m) (τ_m learned, initially ``tau_min``); needs
-            ``node_distance``. Between apart polygons min_i s_i is the distance itself.
+        min_readout: a residual readout on the soft minimum of the node distances,
+            m = −τ_m log Σ_i exp(−s_i / τ_m) (τ_m learned, initially ``tau_min``):
+            d̂ = scale · (m + MLP(y_r ‖ y_o ‖ m)), the MLP's last layer starting at zero.
+            Needs ``node_distance``. Between apart polygons min_i s_i is the distance itself,
+            so the MLP learns a correction (penetration, edges crossing without a vertex inside).
         tau_min: initial τ_m (normalised units).
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
@@ -422,6 +424,8 @@ class GraphDistNet(nn.Module):
             self.distance_in = nn.Parameter(torch.empty(c.layers, width).uniform_(-1.0, 1.0))
         if c.min_readout:
             self.log_tau_min = nn.Parameter(torch.tensor(math.log(c.tau_min)))
+            nn.init.zeros_(self.head[-1].weight)  # d̂ = scale · m at initialisation
+            nn.init.zeros_(self.head[-1].bias)
 
     # ------------------------------------------------------------------ graph plumbing
     def union(self, robot: GraphBatch, obstacles: GraphBatch) -> Union:
@@ -583,17 +587,18 @@ class GraphDistNet(nn.Module):
     def estimate(
         self, pooled: torch.Tensor, s: torch.Tensor | None, mask: torch.Tensor | None = None
     ) -> torch.Tensor:
-        """d̂ (B,) (m) = scale · MLP(y_r ‖ y_o [‖ m]) of the pooled readouts (B, 2 d_h) and, with
-        ``min_readout``, the soft minimum m of the node distances s (B, N) over ``mask``
-        (B, N) (None: all nodes). One-way networks pass the robot nodes only (obstacle nodes
-        have no s_i)."""
-        if self.config.min_readout:
-            tau = self.log_tau_min.exp()
-            logits = -s / tau
-            if mask is not None:
-                logits = logits.masked_fill(~mask, -math.inf)
-            pooled = torch.cat([pooled, -tau * torch.logsumexp(logits, -1, keepdim=True)], -1)
-        return self.head(pooled).squeeze(-1) * self.config.scale
+        """d̂ (B,) (m) of the pooled readouts (B, 2 d_h): scale · MLP(y_r ‖ y_o), or with
+        ``min_readout`` scale · (m + MLP(y_r ‖ y_o ‖ m)), m the soft minimum of the node
+        distances s (B, N) over ``mask`` (B, N) (None: all nodes). One-way networks pass the
+        robot nodes only (obstacle nodes have no s_i)."""
+        if not self.config.min_readout:
+            return self.head(pooled).squeeze(-1) * self.config.scale
+        tau = self.log_tau_min.exp()
+        logits = -s / tau
+        if mask is not None:
+            logits = logits.masked_fill(~mask, -math.inf)
+        m = -tau * torch.logsumexp(logits, -1, keepdim=True)
+        return (m + self.head(torch.cat([pooled, m], -1))).squeeze(-1) * self.config.scale
 
     # ------------------------------------------------------------------ lean inference
     def scene_graph(self, robot: RobotGraph, obstacles: GraphBatch) -> SceneGraph:
