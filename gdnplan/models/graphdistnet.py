@@ -28,6 +28,18 @@ readouts y_o⁽ᵏ⁾ depend on the scene alone. Inference computes them once pe
 work per configuration is the robot graph's (N_r of N = N_r + N_o nodes) plus its soft
 partners among the cached obstacle features.
 
+Distance-aware nodes (``node_distance``, beyond the paper): every node also knows its signed
+distance s_i to the other graph's polygons (:func:`signed_ring_distance`; robot nodes to the
+obstacles, obstacle nodes to the links; normalised units, negative inside). h_k sees only
+differences z_j − z_i, so s_i enters as an absolute per-node term of the first linear layer:
+pre_ij = W_loc (z_j − z_i) + W_rel (z̄_i − z_i) + s_i w_k + b, the same on the three edges of i
+(one-way networks: s = 0 on obstacle nodes, whose features stay scene-only). Between two
+polygons that are apart the distance is min_i s_i (a closest pair has a vertex at one end), so
+``min_readout`` reads d̂ as a correction of the soft minimum m = −τ_m log Σ_i exp(−s_i / τ_m):
+d̂ = scale · (m + MLP(y_r ‖ y_o ‖ m)). The MLP then learns what m misses: penetration depth,
+and overlaps without a vertex inside the other polygon (two thin bars crossing). s and m are
+continuous in the node positions, so d̂ stays continuous.
+
 Readout (Eq. 9–11): per graph g ∈ {r, o} and layer k = 1 … K, α_i = softmax_{i∈g}(a⁽ᵏ⁾ᵀ x_i⁽ᵏ⁾),
 y_g⁽ᵏ⁾ = f(Σ_i α_i x_i⁽ᵏ⁾); y_g = max_k y_g⁽ᵏ⁾ element-wise; d̂ = scale · MLP(y_r ‖ y_o) (m).
 
