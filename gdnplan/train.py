@@ -3,6 +3,7 @@
 Loss per sample (distances normalised by the config's ``scale`` = reach):
 
     L = w · ((d̂ − f) / scale)² / w̄ + λ · (1 − cos(∂d̂/∂q, ∂f/∂q))    (λ = ``grad_weight``, 0 = paper)
+        [+ ν · ((|∂d̂/∂q| − |∂f/∂q|) / scale)²    (ν = ``grad_norm_weight``, with λ > 0)]
 
     w = 1 + μ · exp(−|f| / s_c)      (μ = ``contact_weight``, 0 = paper; s_c = ``contact_scale``)
 
@@ -119,6 +120,20 @@ def distance_loss(d_hat: torch.Tensor, d: torch.Tensor, config: GraphDistNetConf
         return err.mean()
     w = 1 + config.contact_weight * torch.exp(-d.abs() / config.contact_scale)
     return (w * err).sum() / w.sum()
+
+
+def gradient_loss(g_hat: torch.Tensor, g: torch.Tensor, config: GraphDistNetConfig) -> torch.Tensor:
+    """λ · mean(1 − cos(ĝ, g)) + ν · mean(((|ĝ| − |g|) / scale)²) over the samples of a batch
+    with a non-zero label gradient: ĝ = ∂d̂/∂q, g = ∂f/∂q (B, dof) (m/rad), λ = ``grad_weight``,
+    ν = ``grad_norm_weight`` (the slope: cosine alone leaves |ĝ| free)."""
+    norm = g.norm(dim=1)
+    ok = (norm > 1e-9).float()
+    cos = torch.nn.functional.cosine_similarity(g_hat, g, dim=1, eps=1e-9)
+    per_sample = config.grad_weight * (1 - cos)
+    if config.grad_norm_weight > 0:
+        slope = (g_hat.norm(dim=1) - norm) / config.scale
+        per_sample = per_sample + config.grad_norm_weight * slope.square()
+    return (per_sample * ok).sum() / ok.sum().clamp_min(1)
 
 
 def forward_with_grad(
@@ -375,13 +390,10 @@ def train(
             if config.grad_weight > 0:
                 jac = train_t.jac[rows].to(device)
                 d_hat, g_hat = forward_with_grad(step_net, robot_b, obst_b, jac, True, gen)
-                g = train_t.grad[rows].to(device)
-                ok = (g.norm(dim=1) > 1e-9).float()
-                cos = torch.nn.functional.cosine_similarity(g_hat, g, dim=1, eps=1e-9)
-                loss_g = ((1 - cos) * ok).sum() / ok.sum().clamp_min(1)
+                loss_g = gradient_loss(g_hat, train_t.grad[rows].to(device), config)
             else:
                 d_hat, loss_g = step_net(robot_b, obst_b, gen), torch.zeros((), device=device)
-            loss = distance_loss(d_hat, d, config) + config.grad_weight * loss_g
+            loss = distance_loss(d_hat, d, config) + loss_g
             opt.zero_grad()
             loss.backward()
             opt.step()

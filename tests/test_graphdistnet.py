@@ -20,7 +20,7 @@ from gdnplan.models.graphdistnet import (
     nearest_obstacle_nodes,
     signed_ring_distance,
 )
-from gdnplan.train import distance_loss, evaluate
+from gdnplan.train import distance_loss, evaluate, gradient_loss
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS = ROOT / "weights"
@@ -269,6 +269,16 @@ def test_contact_weighted_distance_loss_by_hand():
     assert float(distance_loss(d_hat, d, weighted)) == pytest.approx((4 * 0.04 + 0.16) / 5)
 
 
+def test_gradient_loss_with_slope_term_by_hand():
+    g = torch.tensor([[3.0, 4.0], [1.0, 0.0], [0.0, 0.0]])  # |g| = 5, 1; a zero label left out
+    g_hat = torch.tensor([[6.0, 8.0], [0.0, 2.0], [1.0, 1.0]])  # cos 1 (|ĝ| 10), cos 0 (|ĝ| 2)
+    cosine = GraphDistNetConfig(scale=2.0, grad_weight=0.5)
+    assert float(gradient_loss(g_hat, g, cosine)) == pytest.approx(0.5 * (0 + 1) / 2)
+    slope = cosine.with_(grad_norm_weight=0.1)  # ((10 − 5) / 2)² = 6.25, ((2 − 1) / 2)² = 0.25
+    expected = (0.5 * (0 + 1) + 0.1 * (6.25 + 0.25)) / 2
+    assert float(gradient_loss(g_hat, g, slope)) == pytest.approx(expected)
+
+
 def test_bad_inputs_raise_input_error():
     scene, model = random_model("a")
     with pytest.raises(gp.InputError):
@@ -283,6 +293,8 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig(activation="relu")
     with pytest.raises(gp.InputError):
         GraphDistNetConfig(contact_weight=-1.0)
+    with pytest.raises(gp.InputError, match="grad_norm_weight"):
+        GraphDistNetConfig(grad_norm_weight=1.0)  # without the gradient loss
     with pytest.raises(gp.InputError, match="min_readout needs node_distance"):
         GraphDistNetConfig(min_readout=True)
     with pytest.raises(gp.InputError, match="tau_min"):

@@ -99,6 +99,8 @@ class GraphDistNetConfig:
         tau: initial temperature τ of ``soft_knn`` (normalised units², learned per layer).
         max_edge: densify graph edges longer than this (m), or None.
         grad_weight: weight λ of the gradient loss λ · (1 − cos(∂d̂/∂q, ∂f/∂q)).
+        grad_norm_weight: weight ν of the slope loss ν · ((|∂d̂/∂q| − |∂f/∂q|) / scale)²
+            (trained with ``grad_weight`` > 0 only; the cosine leaves the slope free).
         contact_weight: extra weight μ of samples near contact in the distance loss,
             w = 1 + μ · exp(−|f| / contact_scale) (0 = paper: every sample alike).
         contact_scale: distance (m) over which the contact weight decays.
@@ -126,6 +128,7 @@ class GraphDistNetConfig:
     tau: float = 0.02
     max_edge: float | None = None
     grad_weight: float = 0.0
+    grad_norm_weight: float = 0.0
     contact_weight: float = 0.0
     contact_scale: float = 0.02
     node_distance: bool = False
@@ -143,6 +146,8 @@ class GraphDistNetConfig:
             raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
         if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
             raise InputError("layers, hidden, cross_k and scale must be positive")
+        if self.grad_norm_weight < 0 or (self.grad_norm_weight > 0 and self.grad_weight <= 0):
+            raise InputError("grad_norm_weight must be ≥ 0, and needs grad_weight > 0")
         if self.contact_weight < 0 or self.contact_scale <= 0:
             raise InputError("contact_weight must be ≥ 0 and contact_scale positive")
         if self.min_readout and not self.node_distance:
