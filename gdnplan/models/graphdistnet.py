@@ -434,7 +434,7 @@ class GraphDistNet(nn.Module):
             self.convs.append(mlp([2 * d_in, *c.mlp, c.hidden], c.activation))
         self.attention = nn.Parameter(torch.randn(c.layers, c.hidden) / math.sqrt(c.hidden))
         self.log_tau = nn.Parameter(torch.full((c.layers,), math.log(c.tau)))
-        self.head = mlp([2 * c.hidden + c.min_readout, *c.readout, 1], c.activation)
+        self.head = mlp([2 * c.hidden + int(c.min_readout), *c.readout, 1], c.activation)
         self.out_act = _activation(c.activation)
         if c.node_distance:  # w_k: s_i w_k joins the first linear layer of h_k on every edge
             width = (c.mlp or (c.hidden,))[0]
