@@ -631,7 +631,10 @@ class GraphDistNet(nn.Module):
         out = self.head(torch.cat([pooled, m], -1))
         if c.min_readout:
             return (m + out).squeeze(-1) * c.scale
-        return -tau * torch.logaddexp(-m / tau, -out / tau).squeeze(-1) * c.scale
+        # smin(m, out) = min(m, out) − τ log(1 + e^{−|m − out|/τ}) (twice differentiable
+        # without the overflow of logaddexp's second derivative)
+        soft = torch.minimum(m, out) - tau * nn.functional.softplus(-(m - out).abs() / tau)
+        return soft.squeeze(-1) * c.scale
 
     # ------------------------------------------------------------------ lean inference
     def scene_graph(self, robot: RobotGraph, obstacles: GraphBatch) -> SceneGraph:
