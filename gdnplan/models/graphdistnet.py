@@ -114,9 +114,9 @@ class GraphDistNetConfig:
             so the MLP learns a correction (penetration, edges crossing without a vertex inside).
         bound_readout: read m as an upper bound instead (f ≤ min_i s_i: a vertex at depth δ
             inside the other polygon needs a translation ≥ δ to leave it):
-            d̂ = scale · smin(m, MLP(y_r ‖ y_o ‖ m)), smin(a, b) = −τ_m log(e^{−a/τ_m} + e^{−b/τ_m}),
-            the MLP starting at a constant 1 (d̂ ≈ m). Needs ``node_distance``; not with
-            ``min_readout``.
+            d̂ = scale · smin(m, m + MLP(y_r ‖ y_o ‖ m)), smin(a, b) = −τ_m log(e^{−a/τ_m} +
+            e^{−b/τ_m}): the correction only lowers m (the MLP's last layer starts at zero).
+            Needs ``node_distance``; not with ``min_readout``.
         tau_min: initial τ_m (normalised units).
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
@@ -454,7 +454,7 @@ class GraphDistNet(nn.Module):
         if reads_m:
             self.log_tau_min = nn.Parameter(torch.tensor(math.log(c.tau_min)))
             nn.init.zeros_(self.head[-1].weight)  # d̂ = scale · m (about) at initialisation
-            nn.init.constant_(self.head[-1].bias, 1.0 if c.bound_readout else 0.0)
+            nn.init.zeros_(self.head[-1].bias)
 
     # ------------------------------------------------------------------ graph plumbing
     def union(self, robot: GraphBatch, obstacles: GraphBatch) -> Union:
@@ -628,12 +628,12 @@ class GraphDistNet(nn.Module):
         if mask is not None:
             logits = logits.masked_fill(~mask, -math.inf)
         m = -tau * torch.logsumexp(logits, -1, keepdim=True)
-        out = self.head(torch.cat([pooled, m], -1))
+        r = self.head(torch.cat([pooled, m], -1))
         if c.min_readout:
-            return (m + out).squeeze(-1) * c.scale
-        # smin(m, out) = min(m, out) − τ log(1 + e^{−|m − out|/τ}) (twice differentiable
-        # without the overflow of logaddexp's second derivative)
-        soft = torch.minimum(m, out) - tau * nn.functional.softplus(-(m - out).abs() / tau)
+            return (m + r).squeeze(-1) * c.scale
+        # smin(m, m + r) = m + min(0, r) − τ log(1 + e^{−|r|/τ}) (twice differentiable without
+        # the overflow of logaddexp's second derivative)
+        soft = m + r.clamp_max(0.0) - tau * nn.functional.softplus(-r.abs() / tau)
         return soft.squeeze(-1) * c.scale
 
     # ------------------------------------------------------------------ lean inference
