@@ -360,3 +360,23 @@ def test_training_step_with_gradient_loss_has_finite_gradients(readout):
     loss = distance_loss(d, t.d[rows], config) + gradient_loss(g, t.grad[rows], config)
     loss.backward()
     assert all(torch.isfinite(p.grad).all() for p in net.parameters() if p.grad is not None)
+
+
+@pytest.mark.parametrize("readout", [{}, {"min_readout": True}])
+def test_training_step_with_gradient_loss_has_finite_gradients(readout):
+    """The gradient loss differentiates ∂d̂/∂q once more: every readout must survive it."""
+    from gdnplan.train import forward_with_grad, tensors
+
+    ds = load(TEST_DATA / "a_test.npz")
+    config = GraphDistNetConfig.smooth(
+        scale=1.2, node_distance=True, grad_weight=0.1, grad_norm_weight=0.1, **readout
+    )
+    torch.manual_seed(0)
+    net = GraphDistNet(config)
+    t = tensors(ds, config)
+    rows = torch.arange(64)
+    robot, obstacles = t.batch(rows, "cpu")
+    d, g = forward_with_grad(net, robot, obstacles, t.jac[rows], True)
+    loss = distance_loss(d, t.d[rows], config) + gradient_loss(g, t.grad[rows], config)
+    loss.backward()
+    assert all(torch.isfinite(p.grad).all() for p in net.parameters() if p.grad is not None)
