@@ -43,7 +43,7 @@ def random_model(
     torch.manual_seed(0)
     config = GraphDistNetConfig.smooth(scale=scene.robot.reach, **changes)
     net = GraphDistNet(config)
-    if (config.min_readout or config.bound_readout) and not keep_init:  # a non-constant MLP
+    if config.min_readout and not keep_init:  # a readout MLP that is not yet zero
         torch.nn.init.normal_(net.head[-1].weight, std=0.3)
     return scene, GraphDistNetModel(net, dtype=dtype)
 
@@ -57,7 +57,6 @@ def random_model(
         {"node_distance": True},
         {"node_distance": True, "two_way": False, "min_readout": True},
         {"node_distance": True, "min_readout": True, "tau_min": 0.02},
-        {"node_distance": True, "bound_readout": True, "tau_min": 0.02},
     ],
 )
 def test_autograd_gradient_matches_finite_differences(changes):
@@ -188,7 +187,6 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("d", {"node_distance": True, "two_way": False}),
     ("e", {"node_distance": True, "two_way": False, "min_readout": True}),
     ("b", {"node_distance": True, "min_readout": True}),
-    ("c", {"node_distance": True, "bound_readout": True, "two_way": False}),
 ]
 
 
@@ -297,10 +295,8 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig(contact_weight=-1.0)
     with pytest.raises(gp.InputError, match="grad_norm_weight"):
         GraphDistNetConfig(grad_norm_weight=1.0)  # without the gradient loss
-    with pytest.raises(gp.InputError, match="need node_distance"):
+    with pytest.raises(gp.InputError, match="min_readout needs node_distance"):
         GraphDistNetConfig(min_readout=True)
-    with pytest.raises(gp.InputError, match="choose one"):
-        GraphDistNetConfig(node_distance=True, min_readout=True, bound_readout=True)
     with pytest.raises(gp.InputError, match="tau_min"):
         GraphDistNetConfig(node_distance=True, min_readout=True, tau_min=0.0)
     with pytest.raises(gp.InputError):
@@ -328,11 +324,10 @@ def test_node_distance_warm_start_keeps_the_loaded_function(tmp_path):
         _load_init(GraphDistNet(new.config.with_(min_readout=True)), path)
 
 
-@pytest.mark.parametrize("readout", ["min_readout", "bound_readout"])
-def test_min_readout_starts_at_the_soft_minimum_of_node_distances(readout):
-    """An untrained min/bound readout network is m: between apart polygons about coal's f."""
+def test_min_readout_starts_at_the_soft_minimum_of_node_distances():
+    """An untrained min_readout network is m: between apart polygons about coal's distance."""
     scene, model = random_model(
-        "c", torch.float64, keep_init=True, node_distance=True, **{readout: True}
+        "c", torch.float64, keep_init=True, node_distance=True, min_readout=True
     )
     q = scene.robot.sample(300, seed=2)
     d = gp.CoalModel().distance(scene, q)
@@ -340,26 +335,6 @@ def test_min_readout_starts_at_the_soft_minimum_of_node_distances(readout):
     err = np.abs(model.distance(scene, q) - d)[free]
     tau = model.config.tau_min * model.config.scale
     assert free.sum() > 50 and err.max() < tau * np.log(60)  # soft-min bias ≤ τ log N
-
-
-@pytest.mark.parametrize("readout", [{}, {"min_readout": True}, {"bound_readout": True}])
-def test_training_step_with_gradient_loss_has_finite_gradients(readout):
-    """The gradient loss differentiates ∂d̂/∂q once more: every readout must survive it."""
-    from gdnplan.train import forward_with_grad, tensors
-
-    ds = load(TEST_DATA / "a_test.npz")
-    config = GraphDistNetConfig.smooth(
-        scale=1.2, node_distance=True, grad_weight=0.1, grad_norm_weight=0.1, **readout
-    )
-    torch.manual_seed(0)
-    net = GraphDistNet(config)
-    t = tensors(ds, config)
-    rows = torch.arange(64)
-    robot, obstacles = t.batch(rows, "cpu")
-    d, g = forward_with_grad(net, robot, obstacles, t.jac[rows], True)
-    loss = distance_loss(d, t.d[rows], config) + gradient_loss(g, t.grad[rows], config)
-    loss.backward()
-    assert all(torch.isfinite(p.grad).all() for p in net.parameters() if p.grad is not None)
 
 
 @pytest.mark.parametrize("readout", [{}, {"min_readout": True}])

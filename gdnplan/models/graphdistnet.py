@@ -112,11 +112,6 @@ class GraphDistNetConfig:
             d̂ = scale · (m + MLP(y_r ‖ y_o ‖ m)), the MLP's last layer starting at zero.
             Needs ``node_distance``. Between apart polygons min_i s_i is the distance itself,
             so the MLP learns a correction (penetration, edges crossing without a vertex inside).
-        bound_readout: read m as an upper bound instead (f ≤ min_i s_i: a vertex at depth δ
-            inside the other polygon needs a translation ≥ δ to leave it):
-            d̂ = scale · smin(m, m + MLP(y_r ‖ y_o ‖ m)), smin(a, b) = −τ_m log(e^{−a/τ_m} +
-            e^{−b/τ_m}): the correction only lowers m (the MLP's last layer starts at zero).
-            Needs ``node_distance``; not with ``min_readout``.
         tau_min: initial τ_m (normalised units).
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
@@ -138,7 +133,6 @@ class GraphDistNetConfig:
     contact_scale: float = 0.02
     node_distance: bool = False
     min_readout: bool = False
-    bound_readout: bool = False
     tau_min: float = 1e-3
     scale: float = 1.0
     origin: tuple[float, float] = (0.0, 0.0)
@@ -156,13 +150,8 @@ class GraphDistNetConfig:
             raise InputError("grad_norm_weight must be ≥ 0, and needs grad_weight > 0")
         if self.contact_weight < 0 or self.contact_scale <= 0:
             raise InputError("contact_weight must be ≥ 0 and contact_scale positive")
-        if (self.min_readout or self.bound_readout) and not self.node_distance:
-            raise InputError(
-                "min_readout and bound_readout need node_distance=True (they read the node "
-                "distances)"
-            )
-        if self.min_readout and self.bound_readout:
-            raise InputError("choose one of min_readout and bound_readout")
+        if self.min_readout and not self.node_distance:
+            raise InputError("min_readout needs node_distance=True (it reads the node distances)")
         if self.tau_min <= 0:
             raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
 
@@ -445,15 +434,14 @@ class GraphDistNet(nn.Module):
             self.convs.append(mlp([2 * d_in, *c.mlp, c.hidden], c.activation))
         self.attention = nn.Parameter(torch.randn(c.layers, c.hidden) / math.sqrt(c.hidden))
         self.log_tau = nn.Parameter(torch.full((c.layers,), math.log(c.tau)))
-        reads_m = c.min_readout or c.bound_readout
-        self.head = mlp([2 * c.hidden + int(reads_m), *c.readout, 1], c.activation)
+        self.head = mlp([2 * c.hidden + int(c.min_readout), *c.readout, 1], c.activation)
         self.out_act = _activation(c.activation)
         if c.node_distance:  # w_k: s_i w_k joins the first linear layer of h_k on every edge
             width = (c.mlp or (c.hidden,))[0]
             self.distance_in = nn.Parameter(torch.empty(c.layers, width).uniform_(-1.0, 1.0))
-        if reads_m:
+        if c.min_readout:
             self.log_tau_min = nn.Parameter(torch.tensor(math.log(c.tau_min)))
-            nn.init.zeros_(self.head[-1].weight)  # d̂ = scale · m (about) at initialisation
+            nn.init.zeros_(self.head[-1].weight)  # d̂ = scale · m at initialisation
             nn.init.zeros_(self.head[-1].bias)
 
     # ------------------------------------------------------------------ graph plumbing
@@ -620,21 +608,14 @@ class GraphDistNet(nn.Module):
         ``min_readout`` scale · (m + MLP(y_r ‖ y_o ‖ m)), m the soft minimum of the node
         distances s (B, N) over ``mask`` (B, N) (None: all nodes). One-way networks pass the
         robot nodes only (obstacle nodes have no s_i)."""
-        c = self.config
-        if not (c.min_readout or c.bound_readout):
-            return self.head(pooled).squeeze(-1) * c.scale
+        if not self.config.min_readout:
+            return self.head(pooled).squeeze(-1) * self.config.scale
         tau = self.log_tau_min.exp()
         logits = -s / tau
         if mask is not None:
             logits = logits.masked_fill(~mask, -math.inf)
         m = -tau * torch.logsumexp(logits, -1, keepdim=True)
-        r = self.head(torch.cat([pooled, m], -1))
-        if c.min_readout:
-            return (m + r).squeeze(-1) * c.scale
-        # smin(m, m + r) = m + min(0, r) − τ log(1 + e^{−|r|/τ}) (twice differentiable without
-        # the overflow of logaddexp's second derivative)
-        soft = m + r.clamp_max(0.0) - tau * nn.functional.softplus(-r.abs() / tau)
-        return soft.squeeze(-1) * c.scale
+        return (m + self.head(torch.cat([pooled, m], -1))).squeeze(-1) * self.config.scale
 
     # ------------------------------------------------------------------ lean inference
     def scene_graph(self, robot: RobotGraph, obstacles: GraphBatch) -> SceneGraph:
