@@ -280,12 +280,12 @@ def _pairwise_d2(xr: torch.Tensor, xo: torch.Tensor) -> torch.Tensor:
 
 
 def signed_ring_distance(
-    points: torch.Tensor, nodes: torch.Tensor, next: torch.Tensor, mask: torch.Tensor
+    points: torch.Tensor, nodes: torch.Tensor, next: torch.Tensor, mask: torch.Tensor | None = None
 ) -> torch.Tensor:
     """Signed distance (B, P) of points (B, P, 2) to the union of counter-clockwise rings.
 
-    Rings: nodes (B, M, 2) (or (1, M, 2), shared), next (B, M) and mask (B, M); edge m runs
-    from a_m to b_m = a_next(m). The distance is to the nearest edge,
+    Rings: nodes (B, M, 2) (or (1, M, 2), shared), next (B, M) and mask (B, M) (None: every
+    node is real); edge m runs from a_m to b_m = a_next(m). The distance is to the nearest edge,
 
         δ_pm = |p − a_m − t e_m|,  e_m = b_m − a_m,  t = clamp((p − a_m)·e_m / |e_m|², 0, 1),
 
@@ -300,16 +300,18 @@ def signed_ring_distance(
     w = points[:, :, None] - nodes[:, None]  # (B, P, M, 2)
     t = ((w * e).sum(-1) / (e * e).sum(-1).clamp_min(1e-12)).clamp(0.0, 1.0)
     r = w - t[..., None] * e
-    d2 = (r * r).sum(-1).masked_fill(~mask[:, None], PAD_DIST2)
+    d2 = (r * r).sum(-1)
+    if mask is not None:
+        d2 = d2.masked_fill(~mask[:, None], PAD_DIST2)
     dist = d2.amin(-1).clamp_min(1e-12).sqrt()
     with torch.no_grad():
         wy, ey = w[..., 1], e[..., 1]
         left = e[..., 0] * wy - ey * w[..., 0]  # e × (p − a) > 0: p left of the edge
         up = (wy >= 0) & (wy < ey)  # a_y ≤ p_y < b_y
         down = (wy < 0) & (wy >= ey)  # b_y ≤ p_y < a_y
-        winding = ((up & (left > 0)).int() - (down & (left < 0)).int()).masked_fill(
-            ~mask[:, None], 0
-        )
+        winding = (up & (left > 0)).int() - (down & (left < 0)).int()
+        if mask is not None:
+            winding = winding.masked_fill(~mask[:, None], 0)
         inside = winding.sum(-1) != 0
     return torch.where(inside, -dist, dist)
 
@@ -673,7 +675,7 @@ class GraphDistNet(nn.Module):
         n = x0.shape[1]
         d2 = _pairwise_d2(xr, scene.obstacles)
         idx, log_phi, near = nearest_candidates(d2, c.cross_k + 1)
-        s = self._lean_distances(xr, scene, two_way=True)
+        s = self._lean_distances(xr, scene)
         rows = idx + n * torch.arange(b, device=idx.device)[:, None, None]  # rows of (B N)
         h, score, pooled = None, None, None
         for k in range(c.layers):
@@ -705,7 +707,7 @@ class GraphDistNet(nn.Module):
         b, n_o = nodes.shape[0], len(scene.obstacles)
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
         idx, log_phi, near = nearest_obstacle_nodes(xr, scene.obstacles, min(c.cross_k + 1, n_o))
-        s = self._lean_distances(xr, scene, two_way=False)
+        s = self._lean_distances(xr, scene)
         h, pooled = None, None
         for k in range(c.layers):
             logits = log_phi - near / self.log_tau[k].exp()
@@ -760,9 +762,7 @@ class GraphDistNet(nn.Module):
         last = rest[-1]
         return nn.functional.linear(msg, last.weight, 3 * last.bias)
 
-    def _lean_distances(
-        self, xr: torch.Tensor, scene: SceneGraph, two_way: bool
-    ) -> torch.Tensor | None:
+    def _lean_distances(self, xr: torch.Tensor, scene: SceneGraph) -> torch.Tensor | None:
         """:meth:`node_distances` of normalised robot nodes xr (B, N_r, 2) in ``scene``: (B, N)
         robot then obstacle nodes (two-way), (B, N_r) robot nodes (one-way); None for networks
         without ``node_distance``."""
@@ -771,14 +771,11 @@ class GraphDistNet(nn.Module):
         b, n_r, _ = xr.shape
         xo = scene.obstacles[None]
         n = n_r + xo.shape[1]
-        robot_next = scene.robot_ring[n_r:][None].expand(b, -1)
-        obstacle_next = scene.ring[n + n_r :][None] - n_r
-        ones = torch.ones(1, 1, dtype=torch.bool, device=xr.device)
-        s_r = signed_ring_distance(xr, xo, obstacle_next, ones.expand(1, xo.shape[1]))
-        if not two_way:
+        s_r = signed_ring_distance(xr, xo, scene.ring[n + n_r :][None] - n_r)
+        if not self.config.two_way:
             return s_r
-        s_o = signed_ring_distance(xo.expand(b, -1, -1), xr, robot_next, ones.expand(b, n_r))
-        return torch.cat([s_r, s_o], 1)
+        robot_next = scene.robot_ring[n_r:][None].expand(b, -1)
+        return torch.cat([s_r, signed_ring_distance(xo.expand(b, -1, -1), xr, robot_next)], 1)
 
     def _lean_pool(self, h: torch.Tensor, score: torch.Tensor) -> torch.Tensor:
         """(B, d_h): f(Σ_i α_i x_i), α = softmax(score) over the nodes of h (B, n, d_h)."""
