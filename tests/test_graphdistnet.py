@@ -57,6 +57,7 @@ def random_model(
         {"node_distance": True},
         {"node_distance": True, "two_way": False, "min_readout": True},
         {"node_distance": True, "min_readout": True, "tau_min": 0.02},
+        {"node_distance": True, "min_readout": True, "correction_band": 0.3},
     ],
 )
 def test_autograd_gradient_matches_finite_differences(changes):
@@ -187,6 +188,7 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("d", {"node_distance": True, "two_way": False}),
     ("e", {"node_distance": True, "two_way": False, "min_readout": True}),
     ("b", {"node_distance": True, "min_readout": True}),
+    ("a", {"node_distance": True, "min_readout": True, "correction_band": 0.05, "max_edge": 0.1}),
 ]
 
 
@@ -299,6 +301,10 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig(min_readout=True)
     with pytest.raises(gp.InputError, match="tau_min"):
         GraphDistNetConfig(node_distance=True, min_readout=True, tau_min=0.0)
+    with pytest.raises(gp.InputError, match="correction_band"):
+        GraphDistNetConfig(node_distance=True, correction_band=0.02)  # without min_readout
+    with pytest.raises(gp.InputError, match="correction_band"):
+        GraphDistNetConfig(node_distance=True, min_readout=True, correction_band=-0.02)
     with pytest.raises(gp.InputError):
         GraphDistNetConfig.from_dict({"layers": 2, "width": 3})
     with pytest.raises(gp.InputError):
@@ -337,7 +343,28 @@ def test_min_readout_starts_at_the_soft_minimum_of_node_distances():
     assert free.sum() > 50 and err.max() < tau * np.log(60)  # soft-min bias ≤ τ log N
 
 
-@pytest.mark.parametrize("readout", [{}, {"min_readout": True}])
+def test_correction_band_leaves_the_soft_minimum_away_from_contact():
+    """With a trained-looking (non-zero) readout MLP, the gated network equals the bare soft
+    minimum m once m > 2β (gate < 3e-4) and differs from it in overlap."""
+    band = 0.02
+    scene, gated = random_model(
+        "c", torch.float64, node_distance=True, min_readout=True, correction_band=band
+    )
+    bare = GraphDistNet(gated.config)
+    bare.load_state_dict(gated.net.state_dict())
+    torch.nn.init.zeros_(bare.head[-1].weight)
+    torch.nn.init.zeros_(bare.head[-1].bias)
+    q = scene.robot.sample(400, seed=2)
+    m = GraphDistNetModel(bare, dtype=torch.float64).distance(scene, q)
+    d = gated.distance(scene, q)
+    far, overlap = m > 3 * band, m < 0
+    assert far.sum() > 50 and overlap.sum() > 10
+    assert np.abs(d - m)[far].max() < 1e-3 * np.abs(d - m)[overlap].mean()
+
+
+@pytest.mark.parametrize(
+    "readout", [{}, {"min_readout": True}, {"min_readout": True, "correction_band": 0.02}]
+)
 def test_training_step_with_gradient_loss_has_finite_gradients(readout):
     """The gradient loss differentiates ∂d̂/∂q once more: every readout must survive it."""
     from gdnplan.train import forward_with_grad, tensors

@@ -38,7 +38,10 @@ polygons that are apart the distance is min_i s_i (a closest pair has a vertex a
 ``min_readout`` reads d̂ as a correction of the soft minimum m = −τ_m log Σ_i exp(−s_i / τ_m):
 d̂ = scale · (m + MLP(y_r ‖ y_o ‖ m)). The MLP then learns what m misses: penetration depth,
 and overlaps without a vertex inside the other polygon (two thin bars crossing). s and m are
-continuous in the node positions, so d̂ stays continuous.
+continuous in the node positions, so d̂ stays continuous. ``correction_band`` β confines the
+correction to contact: d̂ = scale · (m + σ(8 (1 − scale · m / β)) · MLP(…)), the gate σ(·) ≈ 1
+in overlap and < 3·10⁻⁴ once m is more than 2β apart, where d̂ is then m itself (exact up to
+the soft minimum) instead of m plus the MLP's noise.
 
 Readout (Eq. 9–11): per graph g ∈ {r, o} and layer k = 1 … K, α_i = softmax_{i∈g}(a⁽ᵏ⁾ᵀ x_i⁽ᵏ⁾),
 y_g⁽ᵏ⁾ = f(Σ_i α_i x_i⁽ᵏ⁾); y_g = max_k y_g⁽ᵏ⁾ element-wise; d̂ = scale · MLP(y_r ‖ y_o) (m).
@@ -113,6 +116,9 @@ class GraphDistNetConfig:
             Needs ``node_distance``. Between apart polygons min_i s_i is the distance itself,
             so the MLP learns a correction (penetration, edges crossing without a vertex inside).
         tau_min: initial τ_m (normalised units).
+        correction_band: β (m) of a gated ``min_readout``, d̂ = scale · (m + g · MLP(…)),
+            g = σ(8 (1 − scale · m / β)): the correction acts in overlap and within ≈ 2β of
+            contact only (None: everywhere). Needs ``min_readout``.
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
     """
@@ -134,6 +140,7 @@ class GraphDistNetConfig:
     node_distance: bool = False
     min_readout: bool = False
     tau_min: float = 1e-3
+    correction_band: float | None = None
     scale: float = 1.0
     origin: tuple[float, float] = (0.0, 0.0)
 
@@ -154,6 +161,8 @@ class GraphDistNetConfig:
             raise InputError("min_readout needs node_distance=True (it reads the node distances)")
         if self.tau_min <= 0:
             raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
+        if self.correction_band is not None and (self.correction_band <= 0 or not self.min_readout):
+            raise InputError("correction_band must be a positive length (m) and needs min_readout")
 
     @classmethod
     def faithful(cls, **changes) -> GraphDistNetConfig:
@@ -608,8 +617,9 @@ class GraphDistNet(nn.Module):
     ) -> torch.Tensor:
         """d̂ (B,) (m) of the pooled readouts (B, 2 d_h): scale · MLP(y_r ‖ y_o), or with
         ``min_readout`` scale · (m + MLP(y_r ‖ y_o ‖ m)), m the soft minimum of the node
-        distances s (B, N) over ``mask`` (B, N) (None: all nodes). One-way networks pass the
-        robot nodes only (obstacle nodes have no s_i)."""
+        distances s (B, N) over ``mask`` (B, N) (None: all nodes), the correction MLP gated by
+        σ(8 (1 − scale · m / β)) with ``correction_band`` β. One-way networks pass the robot
+        nodes only (obstacle nodes have no s_i)."""
         if not self.config.min_readout:
             return self.head(pooled).squeeze(-1) * self.config.scale
         tau = self.log_tau_min.exp()
@@ -617,7 +627,11 @@ class GraphDistNet(nn.Module):
         if mask is not None:
             logits = logits.masked_fill(~mask, -math.inf)
         m = -tau * torch.logsumexp(logits, -1, keepdim=True)
-        return (m + self.head(torch.cat([pooled, m], -1))).squeeze(-1) * self.config.scale
+        correction = self.head(torch.cat([pooled, m], -1))
+        band = self.config.correction_band
+        if band is not None:
+            correction = correction * torch.sigmoid(8 * (1 - m * (self.config.scale / band)))
+        return (m + correction).squeeze(-1) * self.config.scale
 
     # ------------------------------------------------------------------ lean inference
     def scene_graph(self, robot: RobotGraph, obstacles: GraphBatch) -> SceneGraph:
