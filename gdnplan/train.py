@@ -266,13 +266,19 @@ def _load_init(net: GraphDistNet, path: Path) -> None:
     """Load the weights at ``path`` into ``net``; InputError if missing or of another shape.
 
     Weights without the ``node_distance`` input w_k start a ``node_distance`` network at
-    w_k = 0, the function of the loaded network, which then learns to use s_i.
+    w_k = 0, the function of the loaded network, which then learns to use s_i. Weights of a
+    plain readout start a ``correction_band`` network with the head's m input at weight 0 (and
+    τ_m at ``tau_min``): its MLP is then the loaded estimate, used in and near overlap.
     """
     if not path.exists():
         raise InputError(f"--init: {path} does not exist")
     state = load_file(str(path))
     if net.config.node_distance and "distance_in" not in state:
         state["distance_in"] = torch.zeros_like(net.distance_in)
+    first = state.get("head.0.weight")
+    if net.config.correction_band is not None and "log_tau_min" not in state and first is not None:
+        state["head.0.weight"] = torch.cat([first, first.new_zeros(len(first), 1)], 1)
+        state["log_tau_min"] = net.log_tau_min.detach().clone()
     try:
         net.load_state_dict(state)
     except RuntimeError as e:

@@ -57,7 +57,7 @@ def random_model(
         {"node_distance": True},
         {"node_distance": True, "two_way": False, "min_readout": True},
         {"node_distance": True, "min_readout": True, "tau_min": 0.02},
-        {"node_distance": True, "min_readout": True, "correction_band": 0.3},
+        {"node_distance": True, "min_readout": True, "correction_band": 0.3, "probe_split": 3},
     ],
 )
 def test_autograd_gradient_matches_finite_differences(changes):
@@ -189,6 +189,8 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("e", {"node_distance": True, "two_way": False, "min_readout": True}),
     ("b", {"node_distance": True, "min_readout": True}),
     ("a", {"node_distance": True, "min_readout": True, "correction_band": 0.05, "max_edge": 0.1}),
+    ("a", {"node_distance": True, "min_readout": True, "correction_band": 0.05, "probe_split": 4}),
+    ("d", {"node_distance": True, "min_readout": True, "two_way": False, "probe_split": 3}),
 ]
 
 
@@ -305,6 +307,8 @@ def test_bad_inputs_raise_input_error():
         GraphDistNetConfig(node_distance=True, correction_band=0.02)  # without min_readout
     with pytest.raises(gp.InputError, match="correction_band"):
         GraphDistNetConfig(node_distance=True, min_readout=True, correction_band=-0.02)
+    with pytest.raises(gp.InputError, match="probe_split"):
+        GraphDistNetConfig(node_distance=True, probe_split=3)  # without min_readout
     with pytest.raises(gp.InputError):
         GraphDistNetConfig.from_dict({"layers": 2, "width": 3})
     with pytest.raises(gp.InputError):
@@ -343,8 +347,53 @@ def test_min_readout_starts_at_the_soft_minimum_of_node_distances():
     assert free.sum() > 50 and err.max() < tau * np.log(60)  # soft-min bias ≤ τ log N
 
 
+def test_probe_points_find_links_crossing_the_square():
+    """(a)'s links can cross the square with no vertex inside the other polygon: the soft
+    minimum over the vertices misses those overlaps, the one over edge points does not."""
+    scene = gp.make_scene("a")
+    q = scene.robot.sample(3000, seed=4)
+    f = gp.CoalModel().distance(scene, q)
+    m = {}
+    for split in (1, 5):
+        _, model = random_model(
+            "a",
+            torch.float64,
+            keep_init=True,
+            node_distance=True,
+            min_readout=True,
+            probe_split=split,
+            tau_min=1e-4,
+        )
+        m[split] = model.distance(scene, q)
+    deep = f < -0.01
+    assert (m[1][deep] > 0).sum() >= 5  # vertices only: overlaps taken for free space
+    assert (m[5][deep] < 0).all()
+    free = f > 0.01
+    np.testing.assert_allclose(m[5][free], f[free], atol=1e-3)  # still the distance when apart
+
+
+def test_correction_band_warm_start_keeps_the_loaded_estimate_in_overlap(tmp_path):
+    from safetensors.torch import save_file
+
+    from gdnplan.train import _load_init
+
+    scene, old = random_model("a", torch.float64, node_distance=True)
+    path = tmp_path / "old.safetensors"
+    save_file(old.net.state_dict(), str(path))
+    config = old.config.with_(min_readout=True, correction_band=0.01, probe_split=5, tau_min=1e-4)
+    new = GraphDistNet(config)
+    _load_init(new, path)
+    q = scene.robot.sample(3000, seed=4)
+    f = gp.CoalModel().distance(scene, q)
+    d_old, d_new = old.distance(scene, q), GraphDistNetModel(new, torch.float64).distance(scene, q)
+    overlap = f < -0.01
+    np.testing.assert_allclose(d_new[overlap], d_old[overlap], atol=1e-3 * np.abs(d_old).max())
+    free = f > 0.05
+    np.testing.assert_allclose(d_new[free], f[free], atol=1e-3)  # m: the distance itself
+
+
 def test_correction_band_leaves_the_soft_minimum_away_from_contact():
-    """With a trained-looking (non-zero) readout MLP, the gated network equals the bare soft
+    """With a trained-looking (non-zero) readout MLP, the banded network equals the bare soft
     minimum m once m > 2β (gate < 3e-4) and differs from it in overlap."""
     band = 0.02
     scene, gated = random_model(

@@ -38,10 +38,13 @@ polygons that are apart the distance is min_i s_i (a closest pair has a vertex a
 ``min_readout`` reads d̂ as a correction of the soft minimum m = −τ_m log Σ_i exp(−s_i / τ_m):
 d̂ = scale · (m + MLP(y_r ‖ y_o ‖ m)). The MLP then learns what m misses: penetration depth,
 and overlaps without a vertex inside the other polygon (two thin bars crossing). s and m are
-continuous in the node positions, so d̂ stays continuous. ``correction_band`` β confines the
-correction to contact: d̂ = scale · (m + σ(8 (1 − scale · m / β)) · MLP(…)), the gate σ(·) ≈ 1
-in overlap and < 3·10⁻⁴ once m is more than 2β apart, where d̂ is then m itself (exact up to
-the soft minimum) instead of m plus the MLP's noise.
+continuous in the node positions, so d̂ stays continuous. ``probe_split`` p adds the points
+splitting every ring edge into p pieces to m's minimum (not to the graphs): a bar crossing a
+square then has points inside it. ``correction_band`` β hands d̂ to m away from contact:
+d̂ = scale · (g · MLP(…) + (1 − g) · m), g = σ(8 (1 − scale · m / β)) ≈ 1 in overlap and
+< 3·10⁻⁴ once m is more than 2β apart, where d̂ is m itself (exact up to the soft minimum)
+instead of the MLP's estimate; a network trained without m (head input m at weight 0) keeps
+its function in overlap when it gets the band.
 
 Readout (Eq. 9–11): per graph g ∈ {r, o} and layer k = 1 … K, α_i = softmax_{i∈g}(a⁽ᵏ⁾ᵀ x_i⁽ᵏ⁾),
 y_g⁽ᵏ⁾ = f(Σ_i α_i x_i⁽ᵏ⁾); y_g = max_k y_g⁽ᵏ⁾ element-wise; d̂ = scale · MLP(y_r ‖ y_o) (m).
@@ -116,9 +119,12 @@ class GraphDistNetConfig:
             Needs ``node_distance``. Between apart polygons min_i s_i is the distance itself,
             so the MLP learns a correction (penetration, edges crossing without a vertex inside).
         tau_min: initial τ_m (normalised units).
-        correction_band: β (m) of a gated ``min_readout``, d̂ = scale · (m + g · MLP(…)),
-            g = σ(8 (1 − scale · m / β)): the correction acts in overlap and within ≈ 2β of
-            contact only (None: everywhere). Needs ``min_readout``.
+        probe_split: m's minimum also runs over the points splitting every ring edge into
+            this many pieces (1: the nodes only). Needs ``min_readout``.
+        correction_band: β (m) of a banded ``min_readout``, d̂ = scale · (g · MLP(…) +
+            (1 − g) · m), g = σ(8 (1 − scale · m / β)): the MLP's estimate in overlap and
+            near contact, m beyond ≈ 2β (None: the residual m + MLP everywhere). Needs
+            ``min_readout``.
         scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
         origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
     """
@@ -140,6 +146,7 @@ class GraphDistNetConfig:
     node_distance: bool = False
     min_readout: bool = False
     tau_min: float = 1e-3
+    probe_split: int = 1
     correction_band: float | None = None
     scale: float = 1.0
     origin: tuple[float, float] = (0.0, 0.0)
@@ -163,6 +170,8 @@ class GraphDistNetConfig:
             raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
         if self.correction_band is not None and (self.correction_band <= 0 or not self.min_readout):
             raise InputError("correction_band must be a positive length (m) and needs min_readout")
+        if self.probe_split < 1 or (self.probe_split > 1 and not self.min_readout):
+            raise InputError("probe_split must be ≥ 1, and > 1 needs min_readout")
 
     @classmethod
     def faithful(cls, **changes) -> GraphDistNetConfig:
@@ -608,18 +617,67 @@ class GraphDistNet(nn.Module):
             h = self.convs[k][1:](pre).sum(2) * g.mask[..., None]
             y = self.readout(g, h, k + 1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
-        if one_way is not None and s is not None:
-            return self.estimate(pooled, s[:, :one_way], g.mask[:, :one_way])
-        return self.estimate(pooled, s, g.mask)
+        if not self.config.min_readout:
+            return self.estimate(pooled)
+        n_r, nxt = g.n_robot, g.nbr[..., 1]
+        probes, probe_mask = self.probe_distances(
+            g.x0[:, :n_r],
+            g.x0[:, n_r:],
+            nxt[:, :n_r],
+            nxt[:, n_r:] - n_r,
+            g.mask[:, :n_r],
+            g.mask[:, n_r:],
+        )
+        s, mask = (s, g.mask) if one_way is None else (s[:, :one_way], g.mask[:, :one_way])
+        return self.estimate(pooled, torch.cat([s, probes], 1), torch.cat([mask, probe_mask], 1))
+
+    def probe_distances(
+        self,
+        xr: torch.Tensor,
+        xo: torch.Tensor,
+        next_r: torch.Tensor,
+        next_o: torch.Tensor,
+        mask_r: torch.Tensor | None = None,
+        mask_o: torch.Tensor | None = None,
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Signed distances (B, P) and validity (B, P) of the ``probe_split`` points.
+
+        The points a_i + (t/p)(b_i − a_i), t = 1 … p − 1, of every ring edge a_i → b_i =
+        a_next(i) of the robot nodes xr (B, N_r, 2) (to the obstacle rings) and, for two-way
+        networks, of the obstacle nodes xo (B or 1, N_o, 2) (to the links); next_r/next_o
+        (B or 1, N) index each graph's own nodes; masks None: all valid. P = 0 for p = 1.
+        """
+        split = self.config.probe_split
+        t = torch.arange(1, split, dtype=xr.dtype, device=xr.device) / split
+        b = xr.shape[0]
+
+        def points(x: torch.Tensor, nxt: torch.Tensor) -> torch.Tensor:
+            ends = torch.gather(x, 1, nxt[..., None].expand(*nxt.shape, 2))
+            return (x[:, :, None] + t[:, None] * (ends - x)[:, :, None]).flatten(1, 2)
+
+        def valid(mask: torch.Tensor | None, x: torch.Tensor) -> torch.Tensor:
+            if mask is None:
+                return torch.ones(b, x.shape[1] * (split - 1), dtype=torch.bool, device=x.device)
+            return mask.repeat_interleave(split - 1, 1).expand(b, -1)
+
+        s = [signed_ring_distance(points(xr, next_r), xo, next_o, mask_o)]
+        masks = [valid(mask_r, xr)]
+        if self.config.two_way:
+            s.append(signed_ring_distance(points(xo, next_o).expand(b, -1, -1), xr, next_r, mask_r))
+            masks.append(valid(mask_o, xo))
+        return torch.cat(s, 1), torch.cat(masks, 1)
 
     def estimate(
-        self, pooled: torch.Tensor, s: torch.Tensor | None, mask: torch.Tensor | None = None
+        self,
+        pooled: torch.Tensor,
+        s: torch.Tensor | None = None,
+        mask: torch.Tensor | None = None,
     ) -> torch.Tensor:
         """d̂ (B,) (m) of the pooled readouts (B, 2 d_h): scale · MLP(y_r ‖ y_o), or with
-        ``min_readout`` scale · (m + MLP(y_r ‖ y_o ‖ m)), m the soft minimum of the node
-        distances s (B, N) over ``mask`` (B, N) (None: all nodes), the correction MLP gated by
-        σ(8 (1 − scale · m / β)) with ``correction_band`` β. One-way networks pass the robot
-        nodes only (obstacle nodes have no s_i)."""
+        ``min_readout`` scale · (m + MLP(y_r ‖ y_o ‖ m)), m the soft minimum of the signed
+        distances s (B, P) (nodes, then probe points) over ``mask`` (B, P) (None: all), or
+        with ``correction_band`` β scale · (g · MLP(…) + (1 − g) · m), g = σ(8 (1 − scale ·
+        m / β)). One-way networks pass the robot nodes only (obstacle nodes have no s_i)."""
         if not self.config.min_readout:
             return self.head(pooled).squeeze(-1) * self.config.scale
         tau = self.log_tau_min.exp()
@@ -627,11 +685,12 @@ class GraphDistNet(nn.Module):
         if mask is not None:
             logits = logits.masked_fill(~mask, -math.inf)
         m = -tau * torch.logsumexp(logits, -1, keepdim=True)
-        correction = self.head(torch.cat([pooled, m], -1))
+        mlp = self.head(torch.cat([pooled, m], -1))
         band = self.config.correction_band
-        if band is not None:
-            correction = correction * torch.sigmoid(8 * (1 - m * (self.config.scale / band)))
-        return (m + correction).squeeze(-1) * self.config.scale
+        if band is None:
+            return (m + mlp).squeeze(-1) * self.config.scale
+        gate = torch.sigmoid(8 * (1 - m * (self.config.scale / band)))
+        return (m + gate * (mlp - m)).squeeze(-1) * self.config.scale
 
     # ------------------------------------------------------------------ lean inference
     def scene_graph(self, robot: RobotGraph, obstacles: GraphBatch) -> SceneGraph:
@@ -712,7 +771,7 @@ class GraphDistNet(nn.Module):
                 -1,
             )
             pooled = y if pooled is None else torch.maximum(pooled, y)
-        return self.estimate(pooled, s)
+        return self._lean_estimate(pooled, xr, scene, s)
 
     def lean_one_way(self, nodes: torch.Tensor, scene: SceneGraph) -> torch.Tensor:
         """:meth:`lean` for ``two_way=False``: only the robot graph runs per configuration;
@@ -738,7 +797,7 @@ class GraphDistNet(nn.Module):
             y_r = self._lean_pool(h, h @ self.attention[k])
             y = torch.cat([y_r, fixed.readout[k].expand(b, -1)], -1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
-        return self.estimate(pooled, s)
+        return self._lean_estimate(pooled, xr, scene, s)
 
     def _lean_conv(
         self,
@@ -790,6 +849,18 @@ class GraphDistNet(nn.Module):
             return s_r
         robot_next = scene.robot_ring[n_r:][None].expand(b, -1)
         return torch.cat([s_r, signed_ring_distance(xo.expand(b, -1, -1), xr, robot_next)], 1)
+
+    def _lean_estimate(
+        self, pooled: torch.Tensor, xr: torch.Tensor, scene: SceneGraph, s: torch.Tensor | None
+    ) -> torch.Tensor:
+        """:meth:`estimate` for the lean paths: node distances s, then the probe points'."""
+        if not self.config.min_readout:
+            return self.estimate(pooled)
+        n_r, n = xr.shape[1], len(scene.ring) // 2
+        next_r = scene.robot_ring[n_r:][None].expand(xr.shape[0], -1)
+        next_o = scene.ring[n + n_r :][None] - n_r
+        probes, _ = self.probe_distances(xr, scene.obstacles[None], next_r, next_o)
+        return self.estimate(pooled, torch.cat([s, probes], 1))
 
     def _lean_pool(self, h: torch.Tensor, score: torch.Tensor) -> torch.Tensor:
         """(B, d_h): f(Σ_i α_i x_i), α = softmax(score) over the nodes of h (B, n, d_h)."""
