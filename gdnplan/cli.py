@@ -182,7 +182,7 @@ def evaluate_command(
             raise InputError(f"--model: no {model} weights for env {env} in weights/")
     r = ev.evaluate_model(chosen, env, n, n_grad)
     mae = "N/A" if r.mae is None else f"{r.mae:.4f} m ({r.mae_reach:.4f} of reach)"
-    acd = "N/A" if r.acd is None else f"{r.acd:.4f} over {r.n_grad}"
+    acd = "N/A" if r.acd is None else f"{r.acd:.4f} ± {r.acd_se:.4f} over {r.n_grad}"
     typer.echo(
         f"{model} env {env}: n={r.n} time {r.seconds:.4f} s, MAE {mae}, AUC {r.auc:.4f}, ACD {acd}"
     )

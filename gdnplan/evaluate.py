@@ -96,10 +96,21 @@ def cosine_distances(g_model: np.ndarray, g_true: np.ndarray) -> np.ndarray:
     return 1.0 - cos
 
 
+def used_cosine_distances(g_model: np.ndarray, g_true: np.ndarray) -> np.ndarray:
+    """1 − cos(ĝ, g) (n_used,) over the rows where coal's gradient g is non-zero."""
+    used = np.linalg.norm(np.asarray(g_true, float), axis=1) > 0
+    return cosine_distances(g_model[used], g_true[used])
+
+
 def average_cosine_distance(g_model: np.ndarray, g_true: np.ndarray) -> tuple[float, int]:
     """ACD over rows where coal's gradient is non-zero: (mean 1 − cos, rows used)."""
-    used = np.linalg.norm(np.asarray(g_true, float), axis=1) > 0
-    return float(np.mean(cosine_distances(g_model[used], g_true[used]))), int(used.sum())
+    cd = used_cosine_distances(g_model, g_true)
+    return float(np.mean(cd)), len(cd)
+
+
+def standard_error(x: np.ndarray) -> float:
+    """Standard error of the mean of x (n,): s / √n with the sample std s (ddof 1)."""
+    return float(np.std(x, ddof=1) / np.sqrt(len(x))) if len(x) > 1 else float("nan")
 
 
 def timed(fn: Callable[[], Any], repeats: int = 1) -> tuple[Any, float]:
@@ -192,6 +203,7 @@ class Result:
         mae_reach: MAE / reach of the robot, None for score models.
         auc: ROC AUC of f ≤ margin.
         acd: average cosine distance of ∂/∂q, over ``n_grad`` configurations.
+        acd_se: its standard error s / √n_grad (a tail of near-opposite gradients dominates it).
         n_grad: configurations in the ACD.
         abs_error: (n,) |d̂ − f| (for Welch's test), None for score models.
         score: (n,) the model's output d̂ (for ROC curves and scatter plots).
@@ -205,6 +217,7 @@ class Result:
     mae_reach: float | None
     auc: float
     acd: float | None
+    acd_se: float | None
     n_grad: int
     abs_error: np.ndarray | None
     score: np.ndarray
@@ -223,9 +236,7 @@ def evaluate_predictions(
     """Metrics of predictions d̂ (B,) and gradients (n_grad, dof) (first rows of ``ds``)."""
     err = np.abs(d_hat - ds.d) if is_distance else None
     mae = mean_absolute_error(d_hat, ds.d) if is_distance else None
-    acd, n_grad = (
-        (None, 0) if g_hat is None else average_cosine_distance(g_hat, ds.grad[: len(g_hat)])
-    )
+    cd = None if g_hat is None else used_cosine_distances(g_hat, ds.grad[: len(g_hat)])
     return Result(
         method=method,
         env=ds.env,
@@ -234,8 +245,9 @@ def evaluate_predictions(
         mae=mae,
         mae_reach=None if mae is None else mae / reach,
         auc=roc_auc(-d_hat, ds.d <= margin),
-        acd=acd,
-        n_grad=n_grad,
+        acd=None if cd is None else float(np.mean(cd)),
+        acd_se=None if cd is None else standard_error(cd),
+        n_grad=0 if cd is None else len(cd),
         abs_error=err,
         score=d_hat,
     )
@@ -454,7 +466,9 @@ def table1_env(
     """All methods on one environment, and Welch's p of GraphDistNet vs ClearanceNet errors."""
     ds = test_set(env, s.n)
     (_, _), coal_s = timed(lambda: coal_predict(ds, grad=False))
-    rows = [Result("coal", env, len(ds), coal_s, None, None, float("nan"), None, 0, None, ds.d)]
+    rows = [
+        Result("coal", env, len(ds), coal_s, None, None, float("nan"), None, None, 0, None, ds.d)
+    ]
     rows += diffco_rows(env, ds, s)
     learned = {}
     files = {
@@ -479,8 +493,8 @@ Notes (how each number is made; `paper` columns are the paper's Table I):
 
 - Samples: the first n of `data/<env>/test` (seed 1, one obstacle set per sample in b, d, e);
   the same samples for every method. MAE, AUC and time over n; ACD over the first n_grad
-  ([n] in the ACD column), coal's exact gradient as reference, rows with a zero coal gradient
-  left out. AUC: positives are coal's f ≤ 0, the score is −d̂.
+  ([n] in the ACD column, ± its standard error s/√n), coal's exact gradient as reference, rows
+  with a zero coal gradient left out. AUC: positives are coal's f ≤ 0, the score is −d̂.
 - Time: fastest of 3 wall times of the distance batch on this shared 2-core CPU (coal: one run,
   one call per obstacle set including building its coal shapes; learned models: one batched
   pass on one torch thread, GraphDistNet including graph construction). Other jobs shared the
@@ -538,10 +552,15 @@ def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> st
                 f"| {_num(pm, '.4f')} | {p_text} "
                 f"| {_num(PAPER_P[env], '.0e') if learned else ''} "
                 f"| {_num(r.auc, '.4f')} | {_num(pa, '.4f')} "
-                f"| {_num(r.acd, '.4f')}{f' [{r.n_grad}]' if r.acd is not None else ''} "
+                f"| {_num(r.acd, '.4f')}{_se_text(r)} "
                 f"| {_num(pc, '.4f')} |"
             )
     return "\n".join(lines) + "\n" + NOTES
+
+
+def _se_text(r: Result) -> str:
+    """' ± SE [n]' after an ACD, '' for rows without one."""
+    return "" if r.acd is None else f" ± {r.acd_se:.4f} [{r.n_grad}]"
 
 
 def table1(

@@ -52,6 +52,8 @@ def test_cosine_distance_of_known_vectors():
     acd, used = ev.average_cosine_distance(g, ref)  # the zero coal gradient is left out
     assert used == 4
     assert acd == pytest.approx((0 + 2 + 1 - np.sqrt(0.5) + 1) / 4)
+    cd = ev.used_cosine_distances(g, ref)
+    assert ev.standard_error(cd) == pytest.approx(stats.sem(cd))
 
 
 def test_timed_returns_result_and_positive_time():
@@ -93,7 +95,7 @@ def test_fig5_panels_and_detour_path_is_free():
 def test_roc_and_scatter_figures(tmp_path):
     ds = make_shard("a", 1, 0, 50)
     rows = [
-        ev.Result("coal", "a", 50, 0.1, None, None, float("nan"), None, 0, None, ds.d),
+        ev.Result("coal", "a", 50, 0.1, None, None, float("nan"), None, None, 0, None, ds.d),
         ev.evaluate_predictions("noisy", ds, ds.d + 0.01, None, 0.1, True, 1.2),
     ]
     paths = ev.table1_figures({"a": (rows, None)}, tmp_path)
