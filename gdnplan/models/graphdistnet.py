@@ -648,8 +648,10 @@ class GraphDistNet(nn.Module):
         (B or 1, N) index each graph's own nodes; masks None: all valid. P = 0 for p = 1.
         """
         split = self.config.probe_split
-        t = torch.arange(1, split, dtype=xr.dtype, device=xr.device) / split
         b = xr.shape[0]
+        if split == 1:
+            return xr.new_zeros(b, 0), torch.zeros(b, 0, dtype=torch.bool, device=xr.device)
+        t = torch.arange(1, split, dtype=xr.dtype, device=xr.device) / split
 
         def points(x: torch.Tensor, nxt: torch.Tensor) -> torch.Tensor:
             ends = torch.gather(x, 1, nxt[..., None].expand(*nxt.shape, 2))
