@@ -102,17 +102,6 @@ def used_cosine_distances(g_model: np.ndarray, g_true: np.ndarray) -> np.ndarray
     return cosine_distances(g_model[used], g_true[used])
 
 
-def average_cosine_distance(g_model: np.ndarray, g_true: np.ndarray) -> tuple[float, int]:
-    """ACD over rows where coal's gradient is non-zero: (mean 1 − cos, rows used)."""
-    cd = used_cosine_distances(g_model, g_true)
-    return float(np.mean(cd)), len(cd)
-
-
-def standard_error(x: np.ndarray) -> float:
-    """Standard error of the mean of x (n,): s / √n with the sample std s (ddof 1)."""
-    return float(np.std(x, ddof=1) / np.sqrt(len(x))) if len(x) > 1 else float("nan")
-
-
 def timed(fn: Callable[[], Any], repeats: int = 1) -> tuple[Any, float]:
     """Run ``fn`` ``repeats`` times; return its last result and the fastest wall time (s)."""
     best, out = np.inf, None
@@ -246,7 +235,7 @@ def evaluate_predictions(
         mae_reach=None if mae is None else mae / reach,
         auc=roc_auc(-d_hat, ds.d <= margin),
         acd=None if cd is None else float(np.mean(cd)),
-        acd_se=None if cd is None else standard_error(cd),
+        acd_se=None if cd is None else float(stats.sem(cd)),
         n_grad=0 if cd is None else len(cd),
         abs_error=err,
         score=d_hat,

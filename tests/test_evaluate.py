@@ -49,11 +49,21 @@ def test_cosine_distance_of_known_vectors():
     np.testing.assert_allclose(
         ev.cosine_distances(g, ref), [0.0, 2.0, 1 - np.sqrt(0.5), 1.0, 1.0], atol=1e-12
     )
-    acd, used = ev.average_cosine_distance(g, ref)  # the zero coal gradient is left out
-    assert used == 4
-    assert acd == pytest.approx((0 + 2 + 1 - np.sqrt(0.5) + 1) / 4)
-    cd = ev.used_cosine_distances(g, ref)
-    assert ev.standard_error(cd) == pytest.approx(stats.sem(cd))
+    cd = ev.used_cosine_distances(g, ref)  # the zero coal gradient is left out
+    assert len(cd) == 4
+    assert np.mean(cd) == pytest.approx((0 + 2 + 1 - np.sqrt(0.5) + 1) / 4)
+
+
+def test_acd_and_its_standard_error_of_one_flipped_gradient():
+    """One of n gradients reversed: cosine distances (2, 0, …, 0), so the ACD is 2/n and its
+    standard error √(s² / n) with s² = (4 − n (2/n)²) / (n − 1) = 4/n is 2/n too."""
+    ds = make_shard("a", 1, 0, 50)
+    g_hat = ds.grad.copy()
+    g_hat[0] *= -1
+    res = ev.evaluate_predictions("flipped", ds, ds.d, g_hat, 0.1, True, 1.2)
+    n = int((np.linalg.norm(ds.grad, axis=1) > 0).sum())
+    assert res.n_grad == n > 40 and np.linalg.norm(ds.grad[0]) > 0
+    assert res.acd == pytest.approx(2 / n) and res.acd_se == pytest.approx(2 / n)
 
 
 def test_timed_returns_result_and_positive_time():
