@@ -620,7 +620,7 @@ class GraphDistNet(nn.Module):
         if not self.config.min_readout:
             return self.estimate(pooled)
         n_r, nxt = g.n_robot, g.nbr[..., 1]
-        probes, probe_mask = self.probe_distances(
+        probes = self.probe_distances(
             g.x0[:, :n_r],
             g.x0[:, n_r:],
             nxt[:, :n_r],
@@ -629,6 +629,7 @@ class GraphDistNet(nn.Module):
             g.mask[:, n_r:],
         )
         s, mask = (s, g.mask) if one_way is None else (s[:, :one_way], g.mask[:, :one_way])
+        probe_mask = mask.repeat_interleave(self.config.probe_split - 1, 1)  # a probe's node
         return self.estimate(pooled, torch.cat([s, probes], 1), torch.cat([mask, probe_mask], 1))
 
     def probe_distances(
@@ -639,35 +640,30 @@ class GraphDistNet(nn.Module):
         next_o: torch.Tensor,
         mask_r: torch.Tensor | None = None,
         mask_o: torch.Tensor | None = None,
-    ) -> tuple[torch.Tensor, torch.Tensor]:
-        """Signed distances (B, P) and validity (B, P) of the ``probe_split`` points.
+    ) -> torch.Tensor:
+        """Signed distances (B, P) of the ``probe_split`` points.
 
         The points a_i + (t/p)(b_i − a_i), t = 1 … p − 1, of every ring edge a_i → b_i =
         a_next(i) of the robot nodes xr (B, N_r, 2) (to the obstacle rings) and, for two-way
-        networks, of the obstacle nodes xo (B or 1, N_o, 2) (to the links); next_r/next_o
-        (B or 1, N) index each graph's own nodes; masks None: all valid. P = 0 for p = 1.
+        networks, of the obstacle nodes xo (B or 1, N_o, 2) (to the links), node by node in
+        the order of the nodes; next_r/next_o (B or 1, N) index each graph's own nodes; the
+        masks (None: all valid) leave out padded edges. P = 0 for p = 1.
         """
         split = self.config.probe_split
         b = xr.shape[0]
         if split == 1:
-            return xr.new_zeros(b, 0), torch.zeros(b, 0, dtype=torch.bool, device=xr.device)
+            return xr.new_zeros(b, 0)
         t = torch.arange(1, split, dtype=xr.dtype, device=xr.device) / split
 
         def points(x: torch.Tensor, nxt: torch.Tensor) -> torch.Tensor:
             ends = torch.gather(x, 1, nxt[..., None].expand(*nxt.shape, 2))
             return (x[:, :, None] + t[:, None] * (ends - x)[:, :, None]).flatten(1, 2)
 
-        def valid(mask: torch.Tensor | None, x: torch.Tensor) -> torch.Tensor:
-            if mask is None:
-                return torch.ones(b, x.shape[1] * (split - 1), dtype=torch.bool, device=x.device)
-            return mask.repeat_interleave(split - 1, 1).expand(b, -1)
-
-        s = [signed_ring_distance(points(xr, next_r), xo, next_o, mask_o)]
-        masks = [valid(mask_r, xr)]
-        if self.config.two_way:
-            s.append(signed_ring_distance(points(xo, next_o).expand(b, -1, -1), xr, next_r, mask_r))
-            masks.append(valid(mask_o, xo))
-        return torch.cat(s, 1), torch.cat(masks, 1)
+        s = signed_ring_distance(points(xr, next_r), xo, next_o, mask_o)
+        if not self.config.two_way:
+            return s
+        s_o = signed_ring_distance(points(xo, next_o).expand(b, -1, -1), xr, next_r, mask_r)
+        return torch.cat([s, s_o], 1)
 
     def estimate(
         self,
@@ -861,7 +857,7 @@ class GraphDistNet(nn.Module):
         n_r, n = xr.shape[1], len(scene.ring) // 2
         next_r = scene.robot_ring[n_r:][None].expand(xr.shape[0], -1)
         next_o = scene.ring[n + n_r :][None] - n_r
-        probes, _ = self.probe_distances(xr, scene.obstacles[None], next_r, next_o)
+        probes = self.probe_distances(xr, scene.obstacles[None], next_r, next_o)
         return self.estimate(pooled, torch.cat([s, probes], 1))
 
     def _lean_pool(self, h: torch.Tensor, score: torch.Tensor) -> torch.Tensor:
