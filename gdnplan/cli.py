@@ -159,7 +159,7 @@ def evaluate_command(
     env: str = typer.Option("a", help="Environment a-e (its held-out split, seed 1)."),
     model: str = typer.Option("graphdistnet", help="coal | diffco | clearancenet | graphdistnet."),
     n: int = typer.Option(5000, help="Held-out samples (time, MAE, AUC)."),
-    n_grad: int = typer.Option(2000, help="Samples for the ACD."),
+    n_grad: int = typer.Option(5000, help="Samples for the ACD (the first of the n)."),
 ) -> None:
     """Time, MAE, AUC and ACD of one collision model on held-out samples (Table I metrics)."""
     from . import evaluate as ev

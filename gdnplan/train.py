@@ -20,7 +20,8 @@ Metrics (:func:`evaluate`, paper Table I), against coal labels on a held-out spl
 
 * MAE = mean |d̂ − f| (m), also as a fraction of the arm's reach;
 * AUC of the collision classifier d̂ ≤ margin vs f ≤ margin (Mann–Whitney rank formula);
-* ACD = mean (1 − cos(∂d̂/∂q, ∂f/∂q)) over samples where both gradients are non-zero.
+* ACD = mean (1 − cos(∂d̂/∂q, ∂f/∂q)) over samples where coal's gradient is non-zero (a zero
+  model gradient counts as cos = 0), as in :mod:`gdnplan.evaluate`.
 """
 
 from __future__ import annotations
@@ -37,12 +38,11 @@ from pathlib import Path
 import numpy as np
 import torch
 from safetensors.torch import load_file, save_file
-from scipy.stats import rankdata
 from tqdm import tqdm
 
 from .data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from .errors import InputError
-from .evaluate import sha256_prefix
+from .evaluate import roc_auc, sha256_prefix, used_cosine_distances
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
 
@@ -172,40 +172,19 @@ def predict(
     return np.concatenate(ds), (np.concatenate(gs) if grad else None)
 
 
-def roc_auc(labels: np.ndarray, scores: np.ndarray) -> float:
-    """Area under the ROC curve of ``scores`` for binary ``labels`` (rank formula, ties averaged).
-
-    AUC = (Σ_{positives} rank − n₊(n₊ + 1)/2) / (n₊ n₋).
-    """
-    labels = np.asarray(labels, bool)
-    n_pos, n_neg = int(labels.sum()), int((~labels).sum())
-    if n_pos == 0 or n_neg == 0:
-        return float("nan")
-    ranks = rankdata(scores)
-    return float((ranks[labels].sum() - n_pos * (n_pos + 1) / 2) / (n_pos * n_neg))
-
-
-def mean_cosine_distance(g_hat: np.ndarray, g: np.ndarray) -> tuple[float, int]:
-    """Mean of 1 − cos(ĝ, g) over rows where both are non-zero, and how many rows counted."""
-    nh, ng = np.linalg.norm(g_hat, axis=1), np.linalg.norm(g, axis=1)
-    ok = (nh > 1e-12) & (ng > 1e-12)
-    cos = np.sum(g_hat[ok] * g[ok], 1) / (nh[ok] * ng[ok])
-    return float(np.mean(1 - cos)), int(ok.sum())
-
-
 def metrics(
     d_hat: np.ndarray, g_hat: np.ndarray, d: np.ndarray, g: np.ndarray, reach: float, margin: float
 ) -> dict:
     """MAE (m, fraction of reach), AUC of d ≤ margin, ACD; see the module docstring."""
-    acd, n_acd = mean_cosine_distance(g_hat, g)
+    cd = used_cosine_distances(g_hat, g)
     mae = float(np.mean(np.abs(d_hat - d)))
     return {
         "n": len(d),
         "mae_m": mae,
         "mae_reach": mae / reach,
-        "auc": roc_auc(d <= margin, -d_hat),
-        "acd": acd,
-        "acd_n": n_acd,
+        "auc": roc_auc(-d_hat, d <= margin),
+        "acd": float(np.mean(cd)),
+        "acd_n": len(cd),
         "collision_fraction": float(np.mean(d <= margin)),
     }
 
@@ -412,13 +391,13 @@ def train(
         val_mae = float(np.mean(np.abs(val_hat - val_d)))
         score = val_mae / config.scale  # model selection: the loss's terms on validation
         if val_g is not None:
-            acd, _ = mean_cosine_distance(val_g, val_t.grad.double().numpy())
-            score += config.grad_weight * acd
+            cd = used_cosine_distances(val_g, val_t.grad.double().numpy())
+            score += config.grad_weight * float(np.mean(cd))
         entry = {
             "epoch": epoch,
             "train_loss": total / n,
             "val_mae_m": val_mae,
-            "val_auc": roc_auc(val_d <= 0, -val_hat),  # logged, not used for selection
+            "val_auc": roc_auc(-val_hat, val_d <= 0),  # logged, not used for selection
             "val_score": score,
             "lr": state["lr"],
             "seconds": seconds,
