@@ -439,10 +439,9 @@ def train_command(
 
 def _card_config(weights: Path) -> dict:
     """The config of the JSON card beside ``weights`` (InputError when it is missing)."""
-    card = weights.with_suffix(".json")
-    if not card.exists():
-        raise InputError(f"--init: no card {card.name} beside {weights}")
-    return json.loads(card.read_text())["config"]
+    from .models.weights import read_card
+
+    return read_card(weights, "--init")["config"]
 
 
 @app.command("field")

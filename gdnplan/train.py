@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import subprocess
 import time
 from collections.abc import Sequence
@@ -37,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from safetensors.torch import load_file, save_file
+from safetensors.torch import load_file
 from tqdm import tqdm
 
 from .data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
@@ -45,6 +44,7 @@ from .errors import InputError
 from .evaluate import roc_auc, sha256_prefix, used_cosine_distances
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
+from .models.weights import card_path, write_json, write_tensors, write_weights
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS_DIR = ROOT / "weights"
@@ -217,10 +217,8 @@ def _save_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam, state
     best = state.pop("best_state", None)
     if best is not None:
         tensors.update({f"best.{k}": v.contiguous() for k, v in best.items()})
-    tmp = path.with_suffix(".tmp")
-    save_file(tensors, str(tmp))
-    os.replace(tmp, path)
-    _write_json(path.with_suffix(".json"), state)
+    write_tensors(path, tensors)
+    write_json(card_path(path), state)
     if best is not None:
         state["best_state"] = best
 
@@ -233,7 +231,7 @@ def _load_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam) -> di
         keys = {k.split(".", 2)[2]: v for k, v in tensors.items() if k.startswith(f"opt.{i}.")}
         if keys:
             opt.state[p] = keys
-    state = json.loads(path.with_suffix(".json").read_text())
+    state = json.loads(card_path(path).read_text())
     for g in opt.param_groups:
         g["lr"] = state["lr"]
     best = {k[5:]: v for k, v in tensors.items() if k.startswith("best.")}
@@ -264,21 +262,9 @@ def _load_init(net: GraphDistNet, path: Path) -> None:
         raise InputError(f"--init: {path} does not fit this architecture ({e})") from e
 
 
-def _write_json(path: Path, obj: dict) -> None:
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(obj, indent=2, default=float))
-    os.replace(tmp, path)
-
-
 def save_weights(net: GraphDistNet, card: dict, path: Path | str) -> Path:
     """Write ``path`` (safetensors) and the JSON card beside it (config included)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    save_file({k: v.contiguous() for k, v in net.state_dict().items()}, str(tmp))
-    os.replace(tmp, path)
-    _write_json(path.with_suffix(".json"), {**card, "config": net.config.to_dict()})
-    return path
+    return write_weights(path, net.state_dict(), {**card, "config": net.config.to_dict()})
 
 
 load_weights = load_graphdistnet  # weights/<env>.safetensors -> GraphDistNetModel

@@ -1,5 +1,8 @@
+import json
+
 import numpy as np
 import pytest
+import torch
 
 from gdnplan.train import metrics
 
@@ -17,3 +20,33 @@ def test_metrics_hand_computed():
     assert m["auc"] == 1.0  # the one colliding sample has the lowest d̂
     assert m["acd_n"] == 3
     assert m["acd"] == pytest.approx((0.0 + 1.0 + 2.0) / 3)
+
+
+def test_interrupted_training_resumes_to_the_same_weights(tmp_path):
+    """Two epochs in one go equal one epoch, then a resumed run to two epochs (the checkpoint
+    holds weights, Adam's moments, the best state and the log)."""
+    from safetensors.torch import load_file
+
+    from gdnplan.data import generate, split_dir
+    from gdnplan.models.graphdistnet import GraphDistNetConfig
+    from gdnplan.train import train
+
+    for split, n, seed in (("train", 60, 0), ("test", 20, 1)):
+        generate("a", n, seed, split_dir("a", split, tmp_path), workers=1)
+    config = GraphDistNetConfig.smooth().with_(layers=1, grad_weight=0.1)
+
+    def run(name: str, epochs: int) -> dict:
+        return train("a", config, epochs=epochs, batch=16, data_root=tmp_path,
+                     out=tmp_path / f"{name}.safetensors", run_dir=tmp_path / name)  # fmt: skip
+
+    straight = run("straight", 2)
+    run("resumed", 1)
+    resumed = run("resumed", 2)
+    log = json.loads((tmp_path / "resumed" / "checkpoint.json").read_text())["log"]
+    assert [e["epoch"] for e in log] == [0, 1]
+    a, b = load_file(tmp_path / "straight.safetensors"), load_file(tmp_path / "resumed.safetensors")
+    assert set(a) == set(b) and all(torch.equal(a[k], b[k]) for k in a)
+    untimed = [
+        {k: v for k, v in c["test"].items() if "second" not in k} for c in (resumed, straight)
+    ]
+    assert untimed[0] == untimed[1]

@@ -7,15 +7,15 @@ Planners, the CasADi bridge and the evaluation take any :class:`DistanceModel`.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from ..distance import signed_distance, signed_distance_and_grad
-from ..errors import InputError, UnknownNameError
+from ..errors import UnknownNameError
 from ..scene import Scene
+from .weights import card_path, read_card
 
 
 @runtime_checkable
@@ -55,11 +55,7 @@ def load_model(path: Path | str) -> DistanceModel:
 
     The card's ``"model"`` field selects the class (``"graphdistnet"``, ``"clearancenet"``).
     """
-    path = Path(path)
-    card = path.with_suffix(".json")
-    if not card.exists():
-        raise InputError(f"model: card {card} not found; weights need their JSON card beside them")
-    kind = json.loads(card.read_text()).get("model")
+    kind = read_card(path, "model").get("model")
     if kind == "graphdistnet":
         from .graphdistnet import load_graphdistnet
 
@@ -68,7 +64,7 @@ def load_model(path: Path | str) -> DistanceModel:
         from .clearancenet import load as load_clearancenet
 
         return load_clearancenet(path)
-    raise UnknownNameError(f"model: unknown model type {kind!r} in {card.name}")
+    raise UnknownNameError(f"model: unknown model type {kind!r} in {card_path(path).name}")
 
 
 __all__ = ["CoalModel", "DistanceModel", "load_model"]

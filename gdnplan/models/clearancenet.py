@@ -26,19 +26,18 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
-from safetensors.torch import load_file, save_file
 from torch import nn
 
 from ..data import Dataset, pad_polygons
 from ..errors import InputError
 from ..scene import Scene, make_scene
+from .weights import card_path, read_weights, write_weights
 
 POSE_ENVS = ("a", "b", "c", "d")
 DROPOUT_ENVS = ("d", "e")
@@ -189,31 +188,19 @@ class ClearanceNetModel:
 
     def save(self, path: Path | str) -> Path:
         """Write ``path`` (.safetensors) and its JSON card atomically; returns ``path``."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
         card = {**self.card, "model": "clearancenet", "config": asdict(self.net.config)}
-        tmp = path.with_name(path.name + ".tmp")
-        save_file({k: v.contiguous() for k, v in self.net.state_dict().items()}, str(tmp))
-        os.replace(tmp, path)
-        card_tmp = path.with_suffix(".json.tmp")
-        card_tmp.write_text(json.dumps(card, indent=2))
-        os.replace(card_tmp, path.with_suffix(".json"))
-        return path
+        return write_weights(path, self.net.state_dict(), card)
 
 
 def load(path: Path | str) -> ClearanceNetModel:
     """A :class:`ClearanceNetModel` from ``path`` (.safetensors) and its JSON card."""
-    path = Path(path)
-    card_path = path.with_suffix(".json")
-    if not path.exists() or not card_path.exists():
-        raise InputError(f"weights: {path} or its card {card_path.name} is missing")
-    card = json.loads(card_path.read_text())
+    tensors, card = read_weights(path)
     if card.get("model") != "clearancenet":
-        raise InputError(f"weights: {card_path} is not a ClearanceNet card")
+        raise InputError(f"weights: {card_path(path)} is not a ClearanceNet card")
     cfg = card["config"]
     config = ClearanceNetConfig(**{**cfg, "hidden": tuple(cfg["hidden"])})
     net = ClearanceNet(config)
-    net.load_state_dict(load_file(str(path)))
+    net.load_state_dict(tensors)
     return ClearanceNetModel(net, card)
 
 

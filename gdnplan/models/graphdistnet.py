@@ -64,7 +64,6 @@ from __future__ import annotations
 
 import functools
 import itertools
-import json
 import math
 import weakref
 from collections.abc import Callable
@@ -73,12 +72,12 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from safetensors.torch import load_file
 from torch import nn
 
 from ..errors import InputError
 from ..graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
 from ..scene import Scene
+from .weights import read_weights
 
 PAD_DIST2 = 1e6  # squared distance (normalised units²) given to padded candidates
 LEAKY_SLOPE = 0.2  # negative slope of the paper's LeakyReLU
@@ -1027,11 +1026,7 @@ def _repeat(graph: GraphBatch, b: int) -> GraphBatch:
 
 def load_graphdistnet(path: Path | str) -> GraphDistNetModel:
     """A :class:`GraphDistNetModel` from ``path`` (safetensors) and the JSON card beside it."""
-    path = Path(path)
-    card_path = path.with_suffix(".json")
-    if not path.exists() or not card_path.exists():
-        raise InputError(f"weights: {path} or its card {card_path.name} is missing")
-    card = json.loads(card_path.read_text())
+    tensors, card = read_weights(path)
     net = GraphDistNet(GraphDistNetConfig.from_dict(card["config"]))
-    net.load_state_dict(load_file(str(path)))
+    net.load_state_dict(tensors)
     return GraphDistNetModel(net, card)
