@@ -311,17 +311,22 @@ def signed_ring_distance(
     with p on their right). s is continuous in p and in the nodes (the sign switches where
     min δ = 0); masked edges are left out. Between two apart polygons the distance is the
     smallest |s| over the vertices of both, since a closest pair has a vertex at one end.
+
+    The nearest edge and the winding number are found without autograd over all (P, M)
+    pairs; δ is then recomputed, differentiably, for the nearest edge only (the gradient of
+    a minimum is its minimiser's), so the backward pass costs O(B P), not O(B P M).
     """
+    b = points.shape[0]
     ends = torch.gather(nodes, 1, next[..., None].expand(*next.shape, 2))
-    e = (ends - nodes)[:, None]  # (B, 1, M, 2)
-    w = points[:, :, None] - nodes[:, None]  # (B, P, M, 2)
-    t = ((w * e).sum(-1) / (e * e).sum(-1).clamp_min(1e-12)).clamp(0.0, 1.0)
-    r = w - t[..., None] * e
-    d2 = (r * r).sum(-1)
-    if mask is not None:
-        d2 = d2.masked_fill(~mask[:, None], PAD_DIST2)
-    dist = d2.amin(-1).clamp_min(1e-12).sqrt()
+    edges = ends - nodes  # (B or 1, M, 2)
     with torch.no_grad():
+        e = edges[:, None]  # (B, 1, M, 2)
+        w = points[:, :, None] - nodes[:, None]  # (B, P, M, 2)
+        t = ((w * e).sum(-1) / (e * e).sum(-1).clamp_min(1e-12)).clamp_(0.0, 1.0)
+        d2 = (w - t[..., None] * e).square_().sum(-1)
+        if mask is not None:
+            d2 = d2.masked_fill_(~mask[:, None], PAD_DIST2)
+        d2_min, nearest = d2.min(-1)  # (B, P)
         wy, ey = w[..., 1], e[..., 1]
         left = e[..., 0] * wy - ey * w[..., 0]  # e × (p − a) > 0: p left of the edge
         up = (wy >= 0) & (wy < ey)  # a_y ≤ p_y < b_y
@@ -330,6 +335,13 @@ def signed_ring_distance(
         if mask is not None:
             winding = winding.masked_fill(~mask[:, None], 0)
         inside = winding.sum(-1) != 0
+    pick = nearest[..., None].expand(*nearest.shape, 2)
+    a = torch.gather(nodes.expand(b, -1, -1), 1, pick)  # (B, P, 2)
+    e = torch.gather(edges.expand(b, -1, -1), 1, pick)
+    w = points - a
+    t = ((w * e).sum(-1) / (e * e).sum(-1).clamp_min(1e-12)).clamp(0.0, 1.0)
+    dist = (w - t[..., None] * e).square().sum(-1).clamp_min(1e-12).sqrt()
+    dist = torch.where(d2_min < PAD_DIST2, dist, math.sqrt(PAD_DIST2))  # every edge masked
     return torch.where(inside, -dist, dist)
 
 
