@@ -209,6 +209,20 @@ def git_sha() -> str:
         return "unknown"
 
 
+def validate(net: GraphDistNet, val_t: Tensors, device: str = "cpu") -> dict:
+    """Validation MAE (m), AUC (logged, not used for selection) and the model-selection score:
+    the loss's terms, MAE / scale + λ · ACD (λ = ``grad_weight``; the ACD only when λ > 0)."""
+    config = net.config
+    val_hat, val_g = predict(net, val_t, device=device, grad=config.grad_weight > 0)
+    val_d = val_t.d.double().numpy()
+    mae = float(np.mean(np.abs(val_hat - val_d)))
+    score = mae / config.scale
+    if val_g is not None:
+        cd = used_cosine_distances(val_g, val_t.grad.double().numpy())
+        score += config.grad_weight * float(np.mean(cd))
+    return {"val_mae_m": mae, "val_auc": roc_auc(-val_hat, val_d <= 0), "val_score": score}
+
+
 def _save_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam, state: dict) -> None:
     tensors = {f"net.{k}": v.contiguous() for k, v in net.state_dict().items()}
     for i, s in enumerate(opt.state.values()):
@@ -340,6 +354,11 @@ def train(
     if ckpt.exists():
         state = _load_checkpoint(ckpt, net, opt)
         print(f"resumed {run_dir} at epoch {state['epoch']}")
+    elif init is not None:  # the starting weights compete: fine-tuning never makes them worse
+        state["init_val"] = validate(net, val_t, device)
+        state["best"] = state["init_val"]["val_score"]
+        state["best_state"] = {k: v.detach().clone() for k, v in net.state_dict().items()}
+        print(json.dumps({"init": str(init), **state["init_val"]}))
     trained = sum(e["seconds"] for e in state["log"])
     n = len(train_t)
     while state["epoch"] < epochs and state["stale"] < patience:
@@ -372,23 +391,10 @@ def train(
             bar.set_postfix(loss=f"{float(loss.detach()):.2e}", refresh=False)
         seconds = time.perf_counter() - start
         trained += seconds
-        val_hat, val_g = predict(net, val_t, device=device, grad=config.grad_weight > 0)
-        val_d = val_t.d.double().numpy()
-        val_mae = float(np.mean(np.abs(val_hat - val_d)))
-        score = val_mae / config.scale  # model selection: the loss's terms on validation
-        if val_g is not None:
-            cd = used_cosine_distances(val_g, val_t.grad.double().numpy())
-            score += config.grad_weight * float(np.mean(cd))
-        entry = {
-            "epoch": epoch,
-            "train_loss": total / n,
-            "val_mae_m": val_mae,
-            "val_auc": roc_auc(-val_hat, val_d <= 0),  # logged, not used for selection
-            "val_score": score,
-            "lr": state["lr"],
-            "seconds": seconds,
-            "samples_per_s": n / seconds,
-        }
+        val = validate(net, val_t, device)
+        score = val["val_score"]
+        entry = {"epoch": epoch, "train_loss": total / n, **val, "lr": state["lr"]}
+        entry.update(seconds=seconds, samples_per_s=n / seconds)
         state["log"].append(entry)
         print(json.dumps(entry))
         if score < state["best"]:
@@ -404,7 +410,8 @@ def train(
                     g["lr"] = state["lr"]
         state["epoch"] = epoch + 1
         _save_checkpoint(ckpt, net, opt, state)
-    net.load_state_dict(state["best_state"])
+    if state["best_state"] is not None:  # None: no epoch ran and no starting weights
+        net.load_state_dict(state["best_state"])
     plot_losses(state["log"], run_dir / "loss.png", f"{env}-{name}")
     test = evaluate(net, load(split_dir(env, "test", data_root)), device=device)
     log = state["log"]
@@ -429,7 +436,7 @@ def train(
             "epochs": len(log),
             "best_val_score": state["best"],
             "seconds": sum(e["seconds"] for e in log),
-            "samples_per_s": float(np.mean([e["samples_per_s"] for e in log])),
+            "samples_per_s": float(np.mean([e["samples_per_s"] for e in log])) if log else None,
             "device": device,
             "threads": torch.get_num_threads(),
             "compiled": compile,
@@ -440,6 +447,7 @@ def train(
     }
     if init is not None:
         card["init"] = {"path": str(init), "sha256_prefix": sha256_prefix(Path(init))}
+        card["init"].update(state.get("init_val", {}))
     save_weights(net.cpu(), card, out)
     return card
 

@@ -22,17 +22,25 @@ def test_metrics_hand_computed():
     assert m["acd"] == pytest.approx((0.0 + 1.0 + 2.0) / 3)
 
 
-def test_interrupted_training_resumes_to_the_same_weights(tmp_path):
+@pytest.fixture
+def tiny_data(tmp_path):
+    """60 training and 20 test samples of environment (a) under ``tmp_path``."""
+    from gdnplan.data import generate, split_dir
+
+    for split, n, seed in (("train", 60, 0), ("test", 20, 1)):
+        generate("a", n, seed, split_dir("a", split, tmp_path), workers=1)
+    return tmp_path
+
+
+def test_interrupted_training_resumes_to_the_same_weights(tiny_data):
     """Two epochs in one go equal one epoch, then a resumed run to two epochs (the checkpoint
     holds weights, Adam's moments, the best state and the log)."""
     from safetensors.torch import load_file
 
-    from gdnplan.data import generate, split_dir
     from gdnplan.models.graphdistnet import GraphDistNetConfig
     from gdnplan.train import train
 
-    for split, n, seed in (("train", 60, 0), ("test", 20, 1)):
-        generate("a", n, seed, split_dir("a", split, tmp_path), workers=1)
+    tmp_path = tiny_data
     config = GraphDistNetConfig.smooth().with_(layers=1, grad_weight=0.1)
 
     def run(name: str, epochs: int) -> dict:
@@ -50,3 +58,21 @@ def test_interrupted_training_resumes_to_the_same_weights(tmp_path):
         {k: v for k, v in c["test"].items() if "second" not in k} for c in (resumed, straight)
     ]
     assert untimed[0] == untimed[1]
+
+
+def test_fine_tuning_keeps_the_starting_weights_when_no_epoch_beats_them(tiny_data):
+    """A learning rate that wrecks the network: the starting weights win the validation."""
+    from safetensors.torch import load_file
+
+    from gdnplan.models.graphdistnet import GraphDistNetConfig
+    from gdnplan.train import train
+
+    config = GraphDistNetConfig.smooth().with_(layers=1)
+    start, tuned = tiny_data / "start.safetensors", tiny_data / "tuned.safetensors"
+    train("a", config, epochs=1, data_root=tiny_data, out=start, run_dir=tiny_data / "r1")
+    card = train("a", config, epochs=2, lr=50.0, data_root=tiny_data, out=tuned,
+                 run_dir=tiny_data / "r2", init=start)  # fmt: skip
+    log = json.loads((tiny_data / "r2" / "checkpoint.json").read_text())["log"]
+    assert len(log) == 2 and all(e["val_score"] > card["init"]["val_score"] for e in log)
+    a, b = load_file(start), load_file(tuned)
+    assert all(torch.equal(a[k], b[k]) for k in a)
