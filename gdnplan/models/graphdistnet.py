@@ -319,22 +319,10 @@ def signed_ring_distance(
     b = points.shape[0]
     ends = torch.gather(nodes, 1, next[..., None].expand(*next.shape, 2))
     edges = ends - nodes  # (B or 1, M, 2)
-    with torch.no_grad():
-        e = edges[:, None]  # (B, 1, M, 2)
-        w = points[:, :, None] - nodes[:, None]  # (B, P, M, 2)
-        t = ((w * e).sum(-1) / (e * e).sum(-1).clamp_min(1e-12)).clamp_(0.0, 1.0)
-        d2 = (w - t[..., None] * e).square_().sum(-1)
-        if mask is not None:
-            d2 = d2.masked_fill_(~mask[:, None], PAD_DIST2)
-        d2_min, nearest = d2.min(-1)  # (B, P)
-        wy, ey = w[..., 1], e[..., 1]
-        left = e[..., 0] * wy - ey * w[..., 0]  # e × (p − a) > 0: p left of the edge
-        up = (wy >= 0) & (wy < ey)  # a_y ≤ p_y < b_y
-        down = (wy < 0) & (wy >= ey)  # b_y ≤ p_y < a_y
-        winding = (up & (left > 0)).int() - (down & (left < 0)).int()
-        if mask is not None:
-            winding = winding.masked_fill(~mask[:, None], 0)
-        inside = winding.sum(-1) != 0
+    edge_mask = None if mask is None else mask[:, None]
+    d2_min, nearest, inside = _nearest_edge_and_inside(
+        points.detach(), nodes[:, None].detach(), edges[:, None].detach(), edge_mask
+    )
     pick = nearest[..., None].expand(*nearest.shape, 2)
     a = torch.gather(nodes.expand(b, -1, -1), 1, pick)  # (B, P, 2)
     e = torch.gather(edges.expand(b, -1, -1), 1, pick)
@@ -343,6 +331,35 @@ def signed_ring_distance(
     dist = (w - t[..., None] * e).square().sum(-1).clamp_min(1e-12).sqrt()
     dist = torch.where(d2_min < PAD_DIST2, dist, math.sqrt(PAD_DIST2))  # every edge masked
     return torch.where(inside, -dist, dist)
+
+
+@torch.no_grad()
+def _nearest_edge_and_inside(
+    points: torch.Tensor, a: torch.Tensor, e: torch.Tensor, mask: torch.Tensor | None
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """For points (B, P, 2) and edges a_m + t e_m given by a and e (B or 1, P or 1, M, 2),
+    masked edges (mask broadcastable to (B, P, M)) left out: the smallest squared distance
+    min_m δ²_pm (B, P), its edge m (B, P), and whether the winding number around p is
+    non-zero (B, P) (see :func:`signed_ring_distance`).
+
+    x and y are separate contiguous (B, P, M) tensors (no reductions over a trailing 2)."""
+    ax, ay = a[..., 0].contiguous(), a[..., 1].contiguous()
+    ex, ey = e[..., 0].contiguous(), e[..., 1].contiguous()
+    wx = points[..., 0, None] - ax  # (B, P, M)
+    wy = points[..., 1, None] - ay
+    inv = (ex * ex + ey * ey).clamp_min_(1e-12).reciprocal_()
+    t = (wx * ex).add_(wy * ey).mul_(inv).clamp_(0.0, 1.0)
+    d2 = (wx - t * ex).square_().add_((wy - t * ey).square_())
+    if mask is not None:
+        d2 = d2.masked_fill_(~mask, PAD_DIST2)
+    d2_min, nearest = d2.min(-1)
+    left = (ex * wy).sub_(ey * wx)  # e × (p − a) > 0: p left of the edge
+    up = (wy >= 0) & (wy < ey)  # a_y ≤ p_y < b_y
+    down = (wy < 0) & (wy >= ey)  # b_y ≤ p_y < a_y
+    winding = (up & (left > 0)).int() - (down & (left < 0)).int()
+    if mask is not None:
+        winding = winding.masked_fill(~mask, 0)
+    return d2_min, nearest, winding.sum(-1) != 0
 
 
 def _cross_mix(idx: torch.Tensor, w: torch.Tensor, n_r: int) -> tuple[torch.Tensor, torch.Tensor]:
