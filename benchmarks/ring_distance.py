@@ -45,12 +45,12 @@ def textbook(
     return torch.where(winding.sum(-1) != 0, -dist, dist)
 
 
-def run(fn, points: torch.Tensor, chunk: int) -> tuple[torch.Tensor, torch.Tensor]:
-    """s and ∂(Σ s)/∂points over all points, chunk by chunk."""
+def run(fn, points: torch.Tensor, graph, chunk: int) -> tuple[torch.Tensor, torch.Tensor]:
+    """s and ∂(Σ s)/∂points of ``fn`` over all points, to the rings of ``graph``, by chunks."""
     values, grads = [], []
     for start in range(0, len(points), chunk):
         p = points[start : start + chunk].clone().requires_grad_(True)
-        s = fn(p)
+        s = fn(p, graph.nodes, graph.next, graph.mask)
         s.sum().backward()
         values.append(s.detach())
         grads.append(p.grad)
@@ -71,15 +71,12 @@ def main() -> None:
         graph = obstacle_graph(*scene_obstacles([scene]))
         nodes = robot_graph(scene.robot).positions(scene.robot.sample(args.n, seed=3))
         points = torch.tensor(np.repeat(nodes, 5, axis=1), dtype=torch.float32)
-        forms = {
-            "textbook": lambda p: textbook(p, graph.nodes, graph.next, graph.mask),
-            "gdnplan": lambda p: signed_ring_distance(p, graph.nodes, graph.next, graph.mask),
-        }
+        forms = {"textbook": textbook, "gdnplan": signed_ring_distance}
         best, out = dict.fromkeys(forms, np.inf), {}
         for _ in range(args.repeats):
             for name, fn in forms.items():
                 start = time.perf_counter()
-                out[name] = run(fn, points, args.chunk)
+                out[name] = run(fn, points, graph, args.chunk)
                 best[name] = min(best[name], time.perf_counter() - start)
         ds = (out["gdnplan"][0] - out["textbook"][0]).abs().max().item()
         dg = (out["gdnplan"][1] - out["textbook"][1]).abs().max().item()

@@ -11,9 +11,10 @@ Loss per sample (distances normalised by the config's ``scale`` = reach):
 
 with ∂d̂/∂q = Σ_n (∂d̂/∂p_n) ∂p_n/∂q (node Jacobians). Adam, a validation split (10 % of
 train) scored by the loss's terms (MAE/scale + λ · ACD), learning rate halved after 3 epochs
-without improvement, early stopping after ``patience`` epochs, an optional wall-clock budget.
-Each epoch writes a checkpoint (safetensors + JSON) in the run directory, so an interrupted run
-resumes where it stopped; the epoch order is a function of (seed, epoch), hence runs are
+without improvement, early stopping after ``patience`` epochs, an optional wall-clock budget;
+the best-scoring state is kept (when fine-tuning, the starting weights compete too). Each epoch
+writes a checkpoint (safetensors + JSON) in the run directory, so an interrupted run resumes
+where it stopped; the epoch order is a function of (seed, epoch), hence runs are
 deterministic on one device.
 
 Metrics (:func:`evaluate`, paper Table I), against coal labels on a held-out split:
@@ -224,13 +225,13 @@ def validate(net: GraphDistNet, val_t: Tensors, device: str = "cpu") -> dict:
 
 
 def _save_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam, state: dict) -> None:
-    tensors = {f"net.{k}": v.contiguous() for k, v in net.state_dict().items()}
+    tensors = {f"net.{k}": v for k, v in net.state_dict().items()}
     for i, s in enumerate(opt.state.values()):
         for k, v in s.items():
-            tensors[f"opt.{i}.{k}"] = torch.as_tensor(v).contiguous()
+            tensors[f"opt.{i}.{k}"] = torch.as_tensor(v)
     best = state.pop("best_state", None)
     if best is not None:
-        tensors.update({f"best.{k}": v.contiguous() for k, v in best.items()})
+        tensors.update({f"best.{k}": v for k, v in best.items()})
     write_tensors(path, tensors)
     write_json(card_path(path), state)
     if best is not None:
