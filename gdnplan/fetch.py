@@ -40,6 +40,9 @@ from .ur5e import LIFT, solve_ik
 
 STAGES = ("approach", "reach_in", "grasp", "lift", "bring_out", "retreat")
 LIFT_POINTS = 11  # IK points on the lift line, 2 mm apart
+# the closed gripper's stick rests on its shelf (d = 0 by construction); coal's rounding gives
+# up to ≈ −4e-16 m there on some layouts, which is contact, not penetration
+RESTING_CONTACT_TOL = 1e-9  # m
 # bring-out threads the held stick through the entrance: the default RRT step (2 rad) found no
 # seed path; 0.3 rad steps do, given more than the default 5 s on a loaded 2-core machine. Three
 # check points per segment (Ipopt's default is 2): with 2 the certified path cost of
@@ -158,7 +161,7 @@ def run_fetch(
                     name,
                     held,
                     np.array([info["q_grasp"]] * 2),
-                    d >= 0.0,
+                    d >= -RESTING_CONTACT_TOL,
                     d,
                     time.perf_counter() - t0,
                     False,

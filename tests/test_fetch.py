@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 import gdnplan as gp
 from gdnplan import data
 from gdnplan.cli import app
-from gdnplan.fetch import STAGES, run_fetch, stick_clearance
+from gdnplan.fetch import RESTING_CONTACT_TOL, STAGES, run_fetch, stick_clearance
 from gdnplan.models.graphdistnet import GraphDistNet, GraphDistNetConfig, GraphDistNetModel
 from gdnplan.train import predict, tensors
 
@@ -78,6 +78,12 @@ def test_fetch_cli_runs_every_stage(tmp_path):
     for name in STAGES:
         assert name in result.output
     assert out.read_bytes()[:3] == b"GIF"
+
+
+@pytest.mark.parametrize("seed", [2, 4])  # layouts where coal rounds the resting contact below 0
+def test_grasp_accepts_the_stick_resting_on_its_shelf(seed):
+    (stage,) = run_fetch(seed, collision="coal", stages=("grasp",))
+    assert stage.success and abs(stage.min_distance) <= RESTING_CONTACT_TOL  # d = 0 by design
 
 
 def test_unknown_stage_is_bad_input():
