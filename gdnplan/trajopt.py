@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import time
 import tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import casadi
@@ -49,7 +49,7 @@ from .scene import Scene, scene_from_config
 
 WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
 WEIGHTS_FOR_SCENE = {"fetch": "ur5e"}  # scene name -> shipped weights name, where they differ
-TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options"}
+TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options", "solver"}
 INITIAL_GUESSES = ("auto", "straight", "rrt")
 SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
 WARM_START_OPTIONS = {  # Ipopt options of refine rounds started from the last primal-dual point
@@ -99,6 +99,9 @@ class Problem:
         max_step: largest change of any joint between consecutive waypoints (rad).
         goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
         lower, upper: (dof,) joint limits (rad); the robot's limits when None.
+        solver: the solver settings this problem needs (a problem file's ``[solver]`` table,
+            e.g. short RRT-Connect steps for a narrow passage); :func:`plan` uses them unless
+            it is given ``options``. None: the defaults.
     """
 
     scene: Scene
@@ -111,6 +114,7 @@ class Problem:
     goal_tolerance: float = 1e-3
     lower: np.ndarray = field(default=None)  # type: ignore[assignment]
     upper: np.ndarray = field(default=None)  # type: ignore[assignment]
+    solver: TrajoptOptions | None = None
 
     def __post_init__(self) -> None:
         robot = self.scene.robot
@@ -205,6 +209,7 @@ class Problem:
         if not isinstance(options, dict):
             raise ProblemFileError("[options]: expected a table")
         _no_unknown(options, OPTION_KEYS, "[options]")
+        solver = _solver_options(cfg.get("solver"))
         try:
             scene = scene_from_config(cfg)
         except TypeError as e:
@@ -220,10 +225,35 @@ class Problem:
                 start=cfg["start"]["q"],
                 goal=goal.get("q"),
                 goal_position=goal.get("position"),
+                solver=solver,
                 **options,
             )
         except InputError as e:
             raise ProblemFileError(str(e)) from e
+
+
+def _solver_options(table: dict | None) -> TrajoptOptions | None:
+    """TrajoptOptions from a problem file's ``[solver]`` table (None when absent)."""
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise ProblemFileError("[solver]: expected a table")
+    _no_unknown(table, {f.name for f in fields(TrajoptOptions)}, "[solver]")
+    defaults = TrajoptOptions()
+    for key, value in table.items():
+        default = getattr(defaults, key)  # None: int or bool settings with an automatic choice
+        number = isinstance(default, int | float) and not isinstance(default, bool)
+        kind = (int, float) if number else type(default)
+        if default is not None and (
+            not isinstance(value, kind) or isinstance(value, bool) != isinstance(default, bool)
+        ):
+            wanted = (
+                "a number"
+                if number
+                else {bool: "true or false", str: "a string"}.get(type(default), "a table")
+            )
+            raise ProblemFileError(f"[solver] {key}: expected {wanted}, got {value!r}")
+    return replace(defaults, **table)
 
 
 def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
@@ -441,10 +471,13 @@ def plan(
 ) -> Plan:
     """Plan a trajectory for ``problem``; see the module docstring for the formulation.
 
+    ``options`` default to the problem's own solver settings (``problem.solver``), else to
+    :class:`TrajoptOptions`' defaults.
+
     Raises GdnplanError on bad input; a failed solve returns ``Plan(success=False, reason=…)``.
     """
     t0 = time.perf_counter()
-    opts = options or TrajoptOptions()
+    opts = options or problem.solver or TrajoptOptions()
     if opts.initial not in INITIAL_GUESSES:
         raise InputError(f"initial: unknown {opts.initial!r}; choose one of {INITIAL_GUESSES}")
     model = resolve_model(collision, problem.scene, weights)

@@ -102,6 +102,37 @@ def test_fetch_errors():
         gp.make_scene("fetch", seed=5, max_tries=0)
 
 
+def test_bring_out_problem_file_carries_the_fetch_stage_solver_settings():
+    from gdnplan.fetch import BRING_OUT_OPTIONS
+
+    assert gp.Problem.from_toml(PROBLEMS / "fetch_bring_out.toml").solver == BRING_OUT_OPTIONS
+    assert gp.Problem.from_toml(PROBLEMS / "fetch_reach.toml").solver is None
+
+
+def test_bring_out_problem_file_plans_with_coal():
+    """As a user runs it (`gdnplan plan problems/fetch_bring_out.toml --collision coal`): with
+    the default RRT-Connect settings this file found no seed path."""
+    result = gp.plan(gp.Problem.from_toml(PROBLEMS / "fetch_bring_out.toml"), collision="coal")
+    assert result.success and result.min_distance >= 0.0
+
+
+@pytest.mark.parametrize(
+    ("table", "message"),
+    [
+        ("[solver]\nrrt_stepp = 0.3", "unknown key"),
+        ("[solver]\nrrt_step = 'short'", "rrt_step: expected a number"),
+        ("[solver]\nccd = 1", "ccd: expected true or false"),
+        ("solver = 3", "expected a table"),
+    ],
+)
+def test_bad_solver_table_is_a_problem_file_error(tmp_path, table, message):
+    text = (PROBLEMS / "fetch_reach.toml").read_text()
+    path = tmp_path / "p.toml"
+    path.write_text(text + "\n" + table + "\n" if table.startswith("[") else table + "\n" + text)
+    with pytest.raises(gp.ProblemFileError, match=message):
+        gp.Problem.from_toml(path)
+
+
 @pytest.mark.parametrize("name", ["fetch_reach", "fetch_bring_out", "planar2_square", "planar7_d"])
 def test_problem_files_are_valid(name):
     cfg = tomllib.loads((PROBLEMS / f"{name}.toml").read_text())
