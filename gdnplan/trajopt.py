@@ -242,16 +242,12 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
     defaults = TrajoptOptions()
     for key, value in table.items():
         default = getattr(defaults, key)  # None: int or bool settings with an automatic choice
-        number = isinstance(default, int | float) and not isinstance(default, bool)
-        kind = (int, float) if number else type(default)
+        kind = (int, float) if type(default) is float else type(default)
         if default is not None and (
             not isinstance(value, kind) or isinstance(value, bool) != isinstance(default, bool)
         ):
-            wanted = (
-                "a number"
-                if number
-                else {bool: "true or false", str: "a string"}.get(type(default), "a table")
-            )
+            names = {float: "a number", int: "an integer", bool: "true or false"}
+            wanted = names.get(type(default), f"a {type(default).__name__}")
             raise ProblemFileError(f"[solver] {key}: expected {wanted}, got {value!r}")
     return replace(defaults, **table)
 

@@ -122,6 +122,8 @@ def test_bring_out_problem_file_plans_with_coal():
         ("[solver]\nrrt_stepp = 0.3", "unknown key"),
         ("[solver]\nrrt_step = 'short'", "rrt_step: expected a number"),
         ("[solver]\nccd = 1", "ccd: expected true or false"),
+        ("[solver]\nstarts = 2.5", "starts: expected an integer"),
+        ("[solver]\nipopt = 1", "ipopt: expected a dict"),
         ("solver = 3", "expected a table"),
     ],
 )
