@@ -95,10 +95,18 @@ def fetch_scenes(seed: int = 0) -> dict[str, Scene]:
 
 
 def stage_problem(
-    scene: Scene, start: np.ndarray, goal: np.ndarray, margin: float = 0.01, waypoints: int = 30
+    scene: Scene,
+    start: np.ndarray,
+    goal: np.ndarray,
+    margin: float = 0.01,
+    waypoints: int = 30,
+    solver: TrajoptOptions | None = None,
 ) -> Problem:
-    """A joint-space problem start → goal (3,) in ``scene`` with clearance ``margin`` (m)."""
-    return Problem(scene=scene, start=start, goal=goal, waypoints=waypoints, margin=margin)
+    """A joint-space problem start → goal (3,) in ``scene`` with clearance ``margin`` (m) and
+    the stage's own ``solver`` settings (None: the defaults)."""
+    return Problem(
+        scene=scene, start=start, goal=goal, waypoints=waypoints, margin=margin, solver=solver
+    )
 
 
 def lift_path(scene: Scene, n: int = LIFT_POINTS) -> np.ndarray:
@@ -123,10 +131,9 @@ def _planned(
     problem: Problem,
     collision: str | DistanceModel,
     weights: str | Path | None,
-    options: TrajoptOptions | None = None,
 ) -> Stage:
     """Solve one stage with :func:`~gdnplan.trajopt.plan`."""
-    r: Plan = plan(problem, collision=collision, weights=weights, options=options)
+    r: Plan = plan(problem, collision=collision, weights=weights)
     return Stage(name, problem.scene, r.q, r.success, r.min_distance, r.solve_time, True, r.reason)
 
 
@@ -188,8 +195,10 @@ def run_fetch(
                 )
             )
         elif name == "bring_out":
-            problem = stage_problem(held, info["q_lift"], info["q_out"], margin)
-            out.append(_planned(name, problem, collision, weights, BRING_OUT_OPTIONS))
+            problem = stage_problem(
+                held, info["q_lift"], info["q_out"], margin, solver=BRING_OUT_OPTIONS
+            )
+            out.append(_planned(name, problem, collision, weights))
         elif name == "retreat":
             problem = stage_problem(held, info["q_out"], info["q_home"], margin)
             out.append(_planned(name, problem, collision, weights))
