@@ -468,6 +468,17 @@ class SceneGraph:
     robot_ring: torch.Tensor
     fixed: ObstacleFeatures | None = None
 
+    @property
+    def robot_next(self) -> torch.Tensor:
+        """(N_r,) robot-graph index of every robot node's ring successor."""
+        return self.robot_ring[len(self.robot_ring) // 2 :]
+
+    @property
+    def obstacle_next(self) -> torch.Tensor:
+        """(N_o,) obstacle-graph index of every obstacle node's ring successor."""
+        n_r = len(self.ring) // 2 - len(self.obstacles)
+        return self.ring[len(self.ring) // 2 + n_r :] - n_r
+
 
 class GraphDistNet(nn.Module):
     """The network of :class:`GraphDistNetConfig`; ``forward(robot, obstacles) -> d̂ (B,)`` (m)."""
@@ -867,13 +878,12 @@ class GraphDistNet(nn.Module):
         without ``node_distance``."""
         if not self.config.node_distance:
             return None
-        b, n_r, _ = xr.shape
+        b = xr.shape[0]
         xo = scene.obstacles[None]
-        n = n_r + xo.shape[1]
-        s_r = signed_ring_distance(xr, xo, scene.ring[n + n_r :][None] - n_r)
+        s_r = signed_ring_distance(xr, xo, scene.obstacle_next[None])
         if not self.config.two_way:
             return s_r
-        robot_next = scene.robot_ring[n_r:][None].expand(b, -1)
+        robot_next = scene.robot_next[None].expand(b, -1)
         return torch.cat([s_r, signed_ring_distance(xo.expand(b, -1, -1), xr, robot_next)], 1)
 
     def _lean_estimate(
@@ -882,10 +892,8 @@ class GraphDistNet(nn.Module):
         """:meth:`estimate` for the lean paths: node distances s, then the probe points'."""
         if not self.config.min_readout:
             return self.estimate(pooled)
-        n_r, n = xr.shape[1], len(scene.ring) // 2
-        next_r = scene.robot_ring[n_r:][None].expand(xr.shape[0], -1)
-        next_o = scene.ring[n + n_r :][None] - n_r
-        probes = self.probe_distances(xr, scene.obstacles[None], next_r, next_o)
+        next_r = scene.robot_next[None].expand(xr.shape[0], -1)
+        probes = self.probe_distances(xr, scene.obstacles[None], next_r, scene.obstacle_next[None])
         return self.estimate(pooled, torch.cat([s, probes], 1))
 
     def _lean_pool(self, h: torch.Tensor, score: torch.Tensor) -> torch.Tensor:
