@@ -45,7 +45,7 @@ from .errors import InputError
 from .evaluate import roc_auc, sha256_prefix, used_cosine_distances
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
-from .models.weights import card_path, write_json, write_tensors, write_weights
+from .models.weights import card_path, read_card, write_json, write_tensors, write_weights
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS_DIR = ROOT / "weights"
@@ -246,7 +246,7 @@ def _load_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam) -> di
         keys = {k.split(".", 2)[2]: v for k, v in tensors.items() if k.startswith(f"opt.{i}.")}
         if keys:
             opt.state[p] = keys
-    state = json.loads(card_path(path).read_text())
+    state = read_card(path)
     for g in opt.param_groups:
         g["lr"] = state["lr"]
     best = {k[5:]: v for k, v in tensors.items() if k.startswith("best.")}
