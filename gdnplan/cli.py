@@ -114,7 +114,7 @@ def plan_command(
     else:
         verdict = "certified collision-free" if result.success else f"FAILED ({result.reason})"
         typer.echo(
-            f"{problem_file}: {verdict}; coal clearance {result.min_distance:+.4f} m, "
+            f"{problem_file}: {verdict}; {clearance_text(result.min_distance)}, "
             f"solve time {result.solve_time:.2f} s, {result.iterations} iterations, "
             f"path cost {result.path_cost:.3f}"
         )
@@ -134,12 +134,25 @@ def plan_command(
         raise typer.Exit(1)
 
 
+def clearance_text(lower_bound: float) -> str:
+    """'certified clearance ≥ +0.0123 m', or 'clearance not proven' for a −inf bound."""
+    if not np.isfinite(lower_bound):
+        return "clearance not proven"
+    return f"certified clearance ≥ {lower_bound:+.4f} m"
+
+
+def json_number(x: float) -> float | None:
+    """x as a JSON number; None (null) when not finite (JSON has no infinities)."""
+    return float(x) if np.isfinite(x) else None
+
+
 def plan_summary(result) -> dict:
-    """JSON-ready summary of a Plan."""
+    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none)."""
     return {
         "success": bool(result.success),
         "q": np.asarray(result.q).tolist(),
-        "min_distance": float(result.min_distance),
+        "min_distance": json_number(result.min_distance),
+        "sampled_min_distance": json_number(result.sampled_min_distance),
         "solve_time": float(result.solve_time),
         "iterations": int(result.iterations),
         "status": result.status,
@@ -320,7 +333,7 @@ def fetch_command(
             verdict = "certified" if s.success else f"FAILED ({s.detail})"
             typer.echo(
                 f"{s.name:<10} {s.scene.robot.info['gripper']:<8} {how:<8} {verdict}; "
-                f"coal clearance {s.min_distance:+.4f} m, {s.solve_time:.2f} s"
+                f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
             )
         total = sum(s.solve_time for s in stages)
         verdict = "success" if ok else "FAILED"

@@ -16,10 +16,10 @@ bring_out    q_lift → q_out          holding   planned
 retreat      q_out → q_home          holding   planned
 ============ ======================= ========= =========================================
 
-Planned stages use ``margin`` (m) as the constraint d ≥ margin and are certified by the dense
-coal check of :func:`gdnplan.ccd.verify_path` (d > 0 on the continuous path). The lift is
-certified from its first point off the shelf (tcp ≥ 1 mm above it): its start is the contact
-the grasp makes by design.
+Planned stages use ``margin`` (m) as the constraint d ≥ margin and are certified by the coal
+certificate of :func:`gdnplan.ccd.verify_path` (a proof of d > 0 on the continuous path). The
+lift is certified from its first point off the shelf (tcp ≥ 1 mm above it): its start is the
+contact the grasp makes by design.
 """
 
 from __future__ import annotations
@@ -60,7 +60,8 @@ class Stage:
         q: (T, 3) joint path (rad); a single configuration repeated for ``grasp``.
         success: certified collision-free (planned stages: :class:`~gdnplan.trajopt.Plan`'s
             success; grasp: the closed gripper holds the stick; lift: certified off the shelf).
-        min_distance: smallest coal distance of the certified check (m).
+        min_distance: proven lower bound on the coal distance along the stage's path (m; −inf
+            when the certificate could not prove it); grasp: coal's distance at the grasp.
         solve_time: wall time of the stage (s).
         planned: True when solved by :func:`~gdnplan.trajopt.plan`.
         detail: the planner's reason, or what a scripted stage did.
@@ -81,7 +82,7 @@ class Stage:
             "stage": self.name,
             "gripper": self.scene.robot.info["gripper"],
             "success": bool(self.success),
-            "min_distance": float(self.min_distance),
+            "min_distance": float(self.min_distance) if np.isfinite(self.min_distance) else None,
             "solve_time": float(self.solve_time),
             "planned": self.planned,
             "detail": self.detail,

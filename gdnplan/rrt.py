@@ -28,7 +28,9 @@ class RRTResult:
 
 def edge_free(scene: Scene, qa: np.ndarray, qb: np.ndarray, clearance: float) -> bool:
     """True when the segment qa -> qb (dof,) is certified to stay above ``clearance`` (m)."""
-    cert = certify_path(scene, np.stack([qa, qb]), margin=clearance, min_splits=1, stop_early=True)
+    cert = certify_path(
+        scene, np.stack([qa, qb]), margin=clearance, tol=np.inf, min_splits=1, stop_early=True
+    )
     return cert.ok
 
 

@@ -39,7 +39,7 @@ import numpy as np
 import pinocchio as pin
 
 from .casadi_bridge import DistanceCallback, supports_per_link
-from .ccd import certify_path, verify_path
+from .ccd import Certificate, certify_path, verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, ProblemFileError
 from .models import CoalModel, DistanceModel, load_model
@@ -407,7 +407,12 @@ class Plan:
     Attributes:
         success: the certified coal check passed and the goal is reached.
         q: (T, dof) waypoints (rad).
-        min_distance: smallest coal distance of the certified dense check (m).
+        min_distance: proven lower bound on the coal signed distance over the whole continuous
+            path (m; the certificate of :func:`gdnplan.ccd.certify_path`, within 1 mm of the
+            path's true minimum); −inf when the certificate could not prove the path free.
+        sampled_min_distance: smallest coal distance over the configurations the certificate
+            checked (m): an upper bound on the path's minimum (the true minimum lies in
+            [min_distance, sampled_min_distance]).
         solve_time: wall time of the whole call: seeds, solves, verification (s).
         iterations: solver iterations summed over attempts.
         status: the solver's last return status (Ipopt's, or "adam: …").
@@ -427,6 +432,7 @@ class Plan:
     path_cost: float
     model_calls: int
     attempts: int
+    sampled_min_distance: float
 
 
 def path_cost(q: np.ndarray) -> float:
@@ -497,22 +503,25 @@ class _Run:
     reason: str = ""
     model_calls: int = 0
     attempts: int = 0
-    verified: tuple[bool, float] | None = None
+    verified: Certificate | None = None  # the certificate of q at margin 0, when made
 
 
 def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
     """Certify the path with coal, check the goal, package the Plan."""
-    ok, dmin = run.verified or verify_path(problem.scene, run.q, margin=0.0)
+    cert = run.verified or certify_path(problem.scene, run.q, margin=0.0)
     reached = _goal_error(problem, run.q[-1]) <= problem.goal_tolerance
     reason = run.reason
-    if not ok:
-        reason = f"{reason}; certified coal check failed (min distance {dmin:.4f} m)"
+    if not cert.ok:
+        reason = (
+            f"{reason}; coal certificate failed: {cert.reason} "
+            f"(smallest checked distance {cert.min_distance:+.4f} m)"
+        )
     elif not reached:
         reason = f"{reason}; goal not reached"
     return Plan(
-        success=bool(ok and reached),
+        success=bool(cert.ok and reached),
         q=run.q,
-        min_distance=dmin,
+        min_distance=cert.lower_bound,
         solve_time=time.perf_counter() - t0,
         iterations=run.iterations,
         status=run.status,
@@ -520,6 +529,7 @@ def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
         path_cost=path_cost(run.q),
         model_calls=run.model_calls,
         attempts=run.attempts,
+        sampled_min_distance=cert.min_distance,
     )
 
 
@@ -574,7 +584,7 @@ def _line_free(problem: Problem, line: np.ndarray) -> bool:
     """The straight line (T, dof) respects the step bound and is certified at the margin."""
     if np.max(np.abs(np.diff(line, axis=0))) > problem.max_step:
         return False
-    return certify_path(problem.scene, line, problem.margin, stop_early=True).ok
+    return certify_path(problem.scene, line, problem.margin, tol=np.inf, stop_early=True).ok
 
 
 def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, seed: int) -> _Run:
@@ -649,7 +659,7 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
             run.verified = None  # q is not a solver iterate: never accept it
             return q, stats, False
         cert = certify_path(problem.scene, q, margin=0.0)
-        run.verified = (cert.ok, cert.min_distance)
+        run.verified = cert
         if cert.ok:
             return q, stats, True
         bad = list(cert.bad_segments)
