@@ -1,0 +1,171 @@
+"""Atomic writes and output-path checks (gdnplan.files)."""
+
+import errno
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from gdnplan.errors import GdnplanError, OutputError
+from gdnplan.files import atomic_path, check_output_dir, check_output_path, write_text
+
+
+def leftovers(directory) -> list[str]:
+    return sorted(p.name for p in directory.iterdir() if p.name.startswith("."))
+
+
+def test_atomic_write_replaces_the_target_with_the_usual_permissions(tmp_path):
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+    write_text(target, "new")
+    assert target.read_text() == "new" and leftovers(tmp_path) == []
+    mask = os.umask(0o022)
+    os.umask(mask)
+    assert target.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
+def test_the_temporary_name_keeps_the_suffix_for_format_sniffing_writers(tmp_path):
+    with atomic_path(tmp_path / "x.npz") as tmp:
+        assert tmp.parent == tmp_path and tmp.name.startswith(".x.npz.")
+        assert tmp.name.endswith(".tmp.npz")
+        np.savez(tmp, a=np.arange(3))  # would append .npz to another suffix
+    with np.load(tmp_path / "x.npz") as z:
+        assert z["a"].tolist() == [0, 1, 2]
+    assert leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("failure", [RuntimeError("writer bug"), KeyboardInterrupt()])
+def test_a_writer_failing_midway_leaves_the_old_target_and_no_temp(tmp_path, failure):
+    target = tmp_path / "a.gif"
+    target.write_bytes(b"old")
+    with pytest.raises(type(failure)):
+        with atomic_path(target) as tmp:
+            tmp.write_bytes(b"x" * 65536)  # half a GIF
+            raise failure
+    assert target.read_bytes() == b"old" and leftovers(tmp_path) == []
+
+
+def test_a_full_disk_is_a_one_line_error_and_leaves_no_temp(tmp_path, monkeypatch):
+    def full(self, data):
+        with open(self, "wb") as f:
+            f.write(data[:100])
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(type(tmp_path), "write_bytes", full)
+    with pytest.raises(OutputError, match="No space left"):
+        with atomic_path(tmp_path / "a.png") as tmp:
+            tmp.write_bytes(b"y" * 1000)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_failing_rename_leaves_no_temp(tmp_path, monkeypatch):
+    def refuse(src, dst):
+        raise OSError(errno.EXDEV, "cross-device link")
+
+    monkeypatch.setattr(os, "replace", refuse)
+    with pytest.raises(OutputError, match=r"a\.md"):
+        write_text(tmp_path / "a.md", "text")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sigterm_during_a_write_removes_the_temp(tmp_path):
+    import gdnplan
+
+    code = (  # a bare package: gdnplan.files without torch & co. (fast)
+        "import os, signal, sys, types\n"
+        "pkg = sys.modules['gdnplan'] = types.ModuleType('gdnplan')\n"
+        f"pkg.__path__ = [{os.path.dirname(gdnplan.__file__)!r}]\n"
+        "from gdnplan.files import atomic_path\n"
+        f"with atomic_path({str(tmp_path / 'a.gif')!r}) as tmp:\n"
+        "    tmp.write_bytes(b'x' * 1000)\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    print('not reached')\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 128 + signal.SIGTERM and "not reached" not in run.stdout
+    assert list(tmp_path.iterdir()) == []
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # ours is restored (main thread)
+
+
+def special_targets(tmp_path):
+    """A symlink (to a regular file), a directory, a FIFO, a socket and a device node."""
+    real = tmp_path / "real.png"
+    real.write_bytes(b"keep")
+    (tmp_path / "link.png").symlink_to(real)
+    (tmp_path / "dir.png").mkdir()
+    os.mkfifo(tmp_path / "fifo.png")
+    sock = socket.socket(socket.AF_UNIX)
+    sock.bind(str(tmp_path / "sock.png"))
+    names = ["link.png", "dir.png", "fifo.png", "sock.png"]
+    return [tmp_path / n for n in names] + [os.devnull], sock
+
+
+def test_non_regular_targets_are_never_replaced(tmp_path):
+    targets, sock = special_targets(tmp_path)
+    try:
+        for target in targets:
+            before = os.lstat(target)
+            with pytest.raises(OutputError, match=re.escape(str(target))):
+                check_output_path(target, (".png",), "--out")
+            with pytest.raises(OutputError, match=re.escape(str(target))):
+                write_text(target, "x")
+            after = os.lstat(target)
+            assert (before.st_ino, before.st_mode) == (after.st_ino, after.st_mode)
+        assert (tmp_path / "real.png").read_bytes() == b"keep"
+        assert not [n for n in leftovers(tmp_path) if ".tmp" in n]
+    finally:
+        sock.close()
+
+
+def test_check_output_path_rejects_unknown_suffixes_naming_the_allowed_ones(tmp_path):
+    with pytest.raises(OutputError, match=r"--out: .*scene.*\.png or \.pdf"):
+        check_output_path(tmp_path / "scene", (".png", ".pdf"), "--out")
+    assert check_output_path(tmp_path / "scene.PNG", (".png",)) == tmp_path / "scene.PNG"
+
+
+def test_check_output_path_rejects_bad_places_before_any_work(tmp_path):
+    file = tmp_path / "file"
+    file.write_text("")
+    with pytest.raises(OutputError, match=r"(?i)not a directory"):
+        check_output_path(file / "a.png", (".png",))
+    with pytest.raises(OutputError, match=r"(?i)not a directory"):
+        check_output_path(file / "sub" / "a.png", (".png",))
+    with pytest.raises(OutputError, match="not writable"):
+        check_output_path("/proc/a.png", (".png",))  # read-only even for root
+    assert check_output_path(tmp_path / "new" / "dir" / "a.png", (".png",))  # created on write
+    assert not (tmp_path / "new").exists() and leftovers(tmp_path) == []
+
+
+def test_check_output_path_probes_writability(tmp_path, monkeypatch):
+    import tempfile
+
+    def denied(*args, **kwargs):
+        raise PermissionError(errno.EACCES, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", denied)
+    with pytest.raises(OutputError, match="not writable"):
+        check_output_path(tmp_path / "a.png", (".png",))
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only directories")
+def test_check_output_path_rejects_a_read_only_directory(tmp_path):
+    ro = tmp_path / "ro"
+    ro.mkdir(mode=0o555)
+    with pytest.raises(OutputError, match="not writable"):
+        check_output_path(ro / "a.png", (".png",))
+
+
+def test_check_output_dir(tmp_path):
+    file = tmp_path / "file"
+    file.write_text("")
+    with pytest.raises(OutputError, match="not a directory"):
+        check_output_dir(file)
+    with pytest.raises(OutputError, match="not a directory"):
+        check_output_dir(file / "sub")
+    assert check_output_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b"
+    assert issubclass(OutputError, GdnplanError)
