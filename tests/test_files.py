@@ -5,6 +5,7 @@ import os
 import re
 import signal
 import socket
+import stat
 import subprocess
 import sys
 
@@ -169,3 +170,82 @@ def test_check_output_dir(tmp_path):
         check_output_dir(file / "sub")
     assert check_output_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b"
     assert issubclass(OutputError, GdnplanError)
+
+
+# ------------------------------------------------------- the CLI checks outputs before the work
+COMMANDS = {  # command line with {out}, the function doing the work, the suffix it wants
+    "show": (["show", "a", "--out", "{out}"], "gdnplan.cli.scene_and_start", ".png"),
+    "field": (["field", "--out", "{out}"], "gdnplan.evaluate.fig5", ".png"),
+    "plan": (
+        ["plan", "problems/planar2_square.toml", "--animate", "{out}"],
+        "gdnplan.trajopt.plan",
+        ".gif",
+    ),
+    "fetch": (["fetch", "--animate", "{out}"], "gdnplan.fetch.run_fetch", ".gif"),
+    "table1": (["reproduce", "table1", "--out", "{out}"], "gdnplan.evaluate.table1", ".md"),
+    "table2": (
+        ["reproduce", "table2", "--out", "{out}"],
+        "gdnplan.table2.reaching_problems",
+        ".md",
+    ),
+    "train": (["train", "--env", "a", "--out", "{out}"], "gdnplan.train.train", ".safetensors"),
+}
+
+
+def bad_outputs(tmp_path, suffix):
+    """One path of every class of unwritable output for a file with ``suffix``."""
+    file = tmp_path / "file"
+    file.write_text("")
+    (tmp_path / f"dir{suffix}").mkdir()
+    (tmp_path / f"link{suffix}").symlink_to(file)
+    os.mkfifo(tmp_path / f"fifo{suffix}")
+    bad = {
+        "no suffix": tmp_path / "out",
+        "directory": tmp_path / f"dir{suffix}",
+        "symlink": tmp_path / f"link{suffix}",
+        "FIFO": tmp_path / f"fifo{suffix}",
+        "parent is a file": file / f"a{suffix}",
+        "read-only place": f"/proc/a{suffix}",
+        "device without suffix": "/dev/full",
+    }
+    if os.geteuid() == 0:  # a character device (/dev/full's numbers) under a good name
+        os.mknod(tmp_path / f"full{suffix}", stat.S_IFCHR | 0o666, os.makedev(1, 7))
+        bad["device"] = tmp_path / f"full{suffix}"
+    return bad
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_bad_output_paths_fail_before_the_work(command, tmp_path, monkeypatch, capsys):
+    import importlib
+
+    from gdnplan.cli import run
+
+    args, work, suffix = COMMANDS[command]
+    module, name = work.rsplit(".", 1)
+
+    def started(*a, **k):
+        raise AssertionError(f"{work} ran before the output path was checked")
+
+    monkeypatch.setattr(importlib.import_module(module), name, started)
+    monkeypatch.chdir(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    for kind, out in bad_outputs(tmp_path, suffix).items():
+        before = sorted(p.name for p in tmp_path.iterdir())
+        with pytest.raises(SystemExit) as exit_:
+            run([a.replace("{out}", str(out)) for a in args])
+        err = capsys.readouterr().err
+        assert exit_.value.code == 2 and err.startswith("error: --"), (kind, err)
+        assert err.count("\n") == 1 and str(out) in err, (kind, err)
+        assert sorted(p.name for p in tmp_path.iterdir()) == before, kind
+    for path in tmp_path.iterdir():  # nothing was replaced
+        assert path.name == "file" or not path.is_file() or path.is_symlink(), path
+
+
+def test_generate_refuses_a_data_root_that_is_a_file(tmp_path, monkeypatch, capsys):
+    import gdnplan.data
+    from gdnplan.cli import run
+
+    monkeypatch.setattr(gdnplan.data, "generate", lambda *a: pytest.fail("work started"))
+    (tmp_path / "root").write_text("")
+    with pytest.raises(SystemExit) as exit_:
+        run(["generate", "--env", "a", "--n", "5", "--data", str(tmp_path / "root")])
+    assert exit_.value.code == 2 and "error: --data" in capsys.readouterr().err
