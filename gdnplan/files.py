@@ -117,8 +117,8 @@ def check_output_path(
     path = Path(path)
     if suffixes is not None and path.suffix.lower() not in suffixes:
         raise OutputError(
-            f"{what}: {str(path)!r} has no known suffix; expected a file ending in "
-            f"{' or '.join(suffixes)}"
+            f"{what}: {str(path)!r} is not a file name ending in {' or '.join(suffixes)}; "
+            "give one with such a suffix"
         )
     _check_target(path, what)
     _probe_writable(_existing_ancestor(path, what), path, what)
