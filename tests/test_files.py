@@ -249,3 +249,64 @@ def test_generate_refuses_a_data_root_that_is_a_file(tmp_path, monkeypatch, caps
     with pytest.raises(SystemExit) as exit_:
         run(["generate", "--env", "a", "--n", "5", "--data", str(tmp_path / "root")])
     assert exit_.value.code == 2 and "error: --data" in capsys.readouterr().err
+
+
+def enospc_after_a_part(real):
+    """A writer that writes a part of its output through ``real``, then hits a full disk."""
+
+    def writer(*args, **kwargs):
+        real(*args, **kwargs)
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    return writer
+
+
+def test_the_package_writers_leave_no_temp_on_a_full_disk(tmp_path, monkeypatch):
+    """savefig (PNG, GIF frames), safetensors and JSON writers failing midway: no temp left,
+    the previous file kept, one OutputError naming the path."""
+    import torch
+    from matplotlib.figure import Figure
+
+    import gdnplan.models.weights as w
+    from gdnplan.viz import save_figure
+
+    png = tmp_path / "a.png"
+    png.write_bytes(b"old png")
+    monkeypatch.setattr(Figure, "savefig", enospc_after_a_part(Figure.savefig))
+    with pytest.raises(OutputError, match=re.escape(str(png)) + ".*No space left"):
+        save_figure(Figure(), png)
+    monkeypatch.undo()
+    pair = w.write_weights(tmp_path / "n.safetensors", {"x": torch.zeros(2)}, {"v": 1})
+    before = pair.read_bytes(), w.card_path(pair).read_bytes()
+    monkeypatch.setattr(w, "save_file", enospc_after_a_part(w.save_file))
+    with pytest.raises(OutputError, match="No space left"):
+        w.write_weights(pair, {"x": torch.ones(2)}, {"v": 2})
+    assert (pair.read_bytes(), w.card_path(pair).read_bytes()) == before
+    assert png.read_bytes() == b"old png" and leftovers(tmp_path) == []
+
+
+@pytest.mark.filterwarnings("ignore:Animation was deleted")  # the fake writer renders nothing
+@pytest.mark.parametrize("failure", ["enospc", "interrupt"])
+def test_an_animation_failing_midway_leaves_no_temp_gif(tmp_path, monkeypatch, failure):
+    from matplotlib.animation import Animation
+
+    import gdnplan as gp
+    from gdnplan.viz import animate_paths
+
+    real = Animation.save
+
+    def broken(self, filename, *args, **kwargs):
+        with open(filename, "wb") as f:
+            f.write(b"GIF89a" + b"\0" * 65536)  # the first frames
+        if failure == "interrupt":
+            raise KeyboardInterrupt
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(Animation, "save", broken)
+    q = np.array([[0.0, 0.0], [0.1, 0.1]])
+    with pytest.raises(KeyboardInterrupt if failure == "interrupt" else OutputError):
+        animate_paths([(gp.make_scene("a"), q)], tmp_path / "a.gif", per_segment=1)
+    assert list(tmp_path.iterdir()) == []
+    monkeypatch.setattr(Animation, "save", real)
+    animate_paths([(gp.make_scene("a"), q)], tmp_path / "a.gif", per_segment=1)
+    assert (tmp_path / "a.gif").read_bytes()[:6] == b"GIF89a" and leftovers(tmp_path) == []
