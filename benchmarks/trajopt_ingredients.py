@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 import gdnplan as gp
+from gdnplan.files import check_output_path, write_text
 from gdnplan.trajopt import Plan, Problem, TrajoptOptions, plan, tip_position
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -129,6 +130,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", type=Path, default=ROOT / "results" / "trajopt_ingredients.md")
     args = ap.parse_args()
+    check_output_path(args.out, (".md",), "--out")  # before the (long) run
     host = machine()  # git sha of the code that runs, taken before the (long) run
     problems = make_problems(args.n, args.seed)
     rows = []
@@ -148,10 +150,7 @@ def main() -> None:
         f"- date: {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC\n"
     )
     print(text)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = args.out.with_suffix(".tmp")
-    tmp.write_text(text)
-    tmp.replace(args.out)
+    write_text(args.out, text, "--out")
 
 
 if __name__ == "__main__":

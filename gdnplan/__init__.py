@@ -8,6 +8,7 @@ from .errors import (
     GdnplanError,
     InfeasibleProblemError,
     InputError,
+    OutputError,
     ProblemFileError,
     UnknownNameError,
 )
@@ -23,6 +24,7 @@ __all__ = [
     "GdnplanError",
     "InfeasibleProblemError",
     "InputError",
+    "OutputError",
     "Plan",
     "Problem",
     "ProblemFileError",

@@ -11,6 +11,7 @@ import numpy as np
 import typer
 
 from .errors import GdnplanError, InputError, ProblemFileError
+from .files import FIGURE_SUFFIXES, check_output_dir, check_output_path, write_text
 from .scene import Scene, make_scene, scene_from_config
 
 app = typer.Typer(
@@ -75,6 +76,7 @@ def show(
     """Draw the robot, the obstacles and the witness segment of the signed distance."""
     from .viz import save_figure, scene_figure
 
+    check_output_path(out, FIGURE_SUFFIXES, "--out")
     scene, start = scene_and_start(target, seed)
     config = parse_vector(q, "--q") if q is not None else start
     if config is not None:
@@ -102,6 +104,8 @@ def plan_command(
     """
     from .trajopt import Problem, plan
 
+    if animate is not None:
+        check_output_path(animate, (".gif",), "--animate")
     set_threads(threads)
     if view3d:  # fail before planning, not after
         from .viz3d import require_meshcat
@@ -216,6 +220,9 @@ def table1_command(
 
     from . import evaluate as ev
 
+    check_output_path(out, (".md",), "--out")
+    if figures is not None:
+        check_output_dir(figures, "--figures")
     weights = weights or ev.WEIGHTS_DIR
     if not envs or any(e not in ev.ENVS for e in envs):
         raise InputError(f"--envs: expected letters from 'abcde', got {envs!r}")
@@ -239,10 +246,7 @@ def table1_command(
     ]
     text = "\n".join(header) + ev.table1_markdown(results) + "\n"
     typer.echo(text)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, out)
+    write_text(out, text, "--out")
     if figures is not None:
         for path in ev.table1_figures(results, figures):
             typer.echo(f"wrote {path}", err=True)
@@ -267,6 +271,8 @@ def table2_command(
     """The paper's Table II: every collision model × optimiser on random reaching problems."""
     from . import table2
 
+    check_output_path(out, (".md",), "--out")
+    check_output_path(out.with_suffix(".json"), (".json",), "--out")
     chosen = {
         name: [v.strip() for v in value.split(",") if v.strip()]
         for name, value in (("settings", settings), ("methods", methods), ("solvers", solvers))
@@ -316,6 +322,8 @@ def fetch_command(
     """
     from .fetch import run_fetch
 
+    if animate is not None:
+        check_output_path(animate, (".gif",), "--animate")
     set_threads(threads)
     if view3d:  # fail before planning, not after
         from .viz3d import require_meshcat
@@ -373,7 +381,7 @@ def generate_command(
     if split not in SPLITS:
         raise InputError(f"--split: expected one of {sorted(SPLITS)}, got {split!r}")
     split_seed, size = SPLITS[split]
-    target = split_dir(env, split, data or DATA_DIR)
+    target = check_output_dir(split_dir(env, split, data or DATA_DIR), "--data")
     generate(env, n or size, split_seed if seed is None else seed, target, workers, near)
     typer.echo(f"wrote {target}")
 
@@ -406,6 +414,11 @@ def train_command(
     ),
 ) -> None:
     """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
+    if out is not None:
+        check_output_path(out, (".safetensors",), "--out")
+        check_output_path(out.with_suffix(".json"), (".json",), "--out")
+    if run_dir is not None:
+        check_output_dir(run_dir, "--run-dir")
     if model == "clearancenet":
         from .models.clearancenet import train_and_save
 
@@ -467,6 +480,7 @@ def field_command(
     from .evaluate import fig5
     from .viz import save_figure
 
+    check_output_path(out, FIGURE_SUFFIXES, "--out")
     save_figure(fig5(env, grid), out)
     typer.echo(f"wrote {out}")
 

@@ -9,7 +9,16 @@ set per sample with ``make_scene(env, seed=scene_seed)``, where
 
 so a split is a pure function of (env, seed, n) and train (seed 0) and test (seed 1) never
 share a scene. Shards of ``SHARD_SIZE`` samples are written by a pool of processes, each to a
-temporary file renamed when complete; re-running skips shards that exist.
+temporary file renamed when complete (:func:`gdnplan.files.atomic_path`).
+
+Resuming: the folder's ``manifest.json`` records the settings of its split (env, seed, near,
+shard size), written before the first shard. Running :func:`generate` again with the same
+settings continues the split: shard k holds samples k · SHARD_SIZE … of the n asked for, so
+shards that exist with exactly that size are kept, a shorter last shard of a smaller earlier
+n is made again at its full size, and the missing ones are made; the folder then holds the
+same n samples as a one-shot run of n. Other settings (another env, seed or near), a smaller n
+than the folder already holds, or shards without a manifest are refused with an InputError
+naming the setting, never mixed into the split.
 
 The ``ur5e`` environment (the fetch robot, paper §V-C) varies the robot as well: each sample
 draws a gripper state (open, closed, holding), a storage layout and 1–3 random boxes around
@@ -60,6 +69,7 @@ for ``ur5e`` ``nodes`` is zero-padded to the largest robot graph.
 
 from __future__ import annotations
 
+import json
 import os
 from dataclasses import dataclass
 from functools import lru_cache
@@ -71,6 +81,7 @@ from tqdm import tqdm
 
 from .distance import signed_distance, signed_distance_and_grad
 from .errors import InputError, UnknownNameError
+from .files import atomic_path, write_text
 from .robot import Robot, load_robot
 from .scene import ENV_ROBOT, Scene, clear_of_base, make_scene
 from .ur5e import GRIPPER_STATES, TABLE_V
@@ -159,9 +170,8 @@ class Dataset:
         if compact:
             arrays["nodes"] = np.zeros((len(self), 0, 2), np.float32)
             arrays["obstacles"] = arrays["obstacles"].astype(np.float32)
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez_compressed(tmp, env=np.array(self.env), **arrays)
-        os.replace(tmp, path)
+        with atomic_path(path, "shard") as tmp, open(tmp, "wb") as f:
+            np.savez_compressed(f, env=np.array(self.env), **arrays)
 
 
 def pad_polygons(polys: list[list[np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
@@ -334,6 +344,61 @@ def shard_paths(out_dir: Path | str, n: int) -> list[tuple[int, int, Path]]:
     ]
 
 
+MANIFEST = "manifest.json"
+MANIFEST_OPTIONS = {"env": "--env", "seed": "--seed", "near": "--near", "shard_size": "SHARD_SIZE"}
+
+
+def _check_manifest(out_dir: Path, settings: dict) -> None:
+    """Write ``out_dir``'s manifest, or check that it records ``settings`` (InputError if not)."""
+    path = out_dir / MANIFEST
+    if not path.exists():
+        if any(out_dir.glob("shard_*.npz")):
+            raise InputError(
+                f"data: {out_dir} holds shards but no {MANIFEST}, so their settings cannot be "
+                "checked; move them away or generate into another --data folder"
+            )
+        write_text(path, json.dumps(settings, indent=2) + "\n", "--data")
+        return
+    try:
+        recorded = json.loads(path.read_text())
+    except (ValueError, OSError) as e:
+        raise InputError(f"data: {path} is not a readable manifest ({e}); move the folder") from e
+    for key, option in MANIFEST_OPTIONS.items():
+        if not isinstance(recorded, dict) or recorded.get(key) != settings[key]:
+            was = recorded.get(key) if isinstance(recorded, dict) else None
+            raise InputError(
+                f"{option}: {out_dir} holds a split made with {key} = {was!r}, not "
+                f"{settings[key]!r} ({MANIFEST}); use the same setting to continue it, or "
+                "another --data folder"
+            )
+
+
+def _shard_size(path: Path) -> int | None:
+    """Samples in the shard ``path`` (None when it cannot be read: it is made again)."""
+    try:
+        with np.load(path) as z:
+            return len(z["q"])
+    except (OSError, ValueError, KeyError):
+        return None
+
+
+def _missing_shards(out_dir: Path, n: int) -> list[tuple[int, int, Path]]:
+    """The shards of an n-sample split still to make in ``out_dir`` (module docstring);
+    InputError when the folder holds more than n samples."""
+    plan = shard_paths(out_dir, n)
+    names = {p.name for _, _, p in plan}
+    shards = [p for p in out_dir.glob("shard_*.npz") if not p.name.endswith(".tmp.npz")]
+    extra = [p for p in shards if p.name not in names]
+    sizes = {p: _shard_size(p) for _, _, p in plan if p.exists()}
+    if extra or any((sizes.get(p) or 0) > k for _, k, p in plan):
+        held = sum(_shard_size(p) or 0 for p in shards)
+        raise InputError(
+            f"--n: {out_dir} already holds {held} samples of this split, more than n = {n}; "
+            f"ask for n ≥ {held} to continue it, or use another --data folder"
+        )
+    return [(s, k, p) for s, k, p in plan if sizes.get(p) != k]
+
+
 def generate(
     env: str,
     n: int,
@@ -342,7 +407,8 @@ def generate(
     workers: int | None = None,
     near: float = 0.0,
 ) -> Path:
-    """Write an n-sample split of ``env`` as shards in ``out_dir``; finished shards are kept.
+    """Write an n-sample split of ``env`` as shards in ``out_dir``, or continue the one there
+    (finished shards are kept; other settings are refused, see the module docstring).
 
     Args:
         env: environment name (``"a"`` … ``"e"``, ``"ur5e"``).
@@ -360,13 +426,13 @@ def generate(
         raise UnknownNameError(f"env: unknown environment {env!r}; choose one of {list(ENVS)}")
     if n < 1:
         raise InputError(f"n: expected a positive number of samples, got {n}")
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     if not 0.0 <= near <= 1.0:
         raise InputError(f"near: expected a fraction in [0, 1], got {near}")
-    jobs = [
-        (env, seed, s, k, str(p), near) for s, k, p in shard_paths(out_dir, n) if not p.exists()
-    ]
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    settings = {"env": env, "seed": int(seed), "near": float(near), "shard_size": SHARD_SIZE}
+    _check_manifest(out_dir, settings)
+    jobs = [(env, seed, s, k, str(p), near) for s, k, p in _missing_shards(out_dir, n)]
     done = n - sum(j[3] for j in jobs)
     workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
     with tqdm(total=n, initial=done, desc=f"generate {env} → {out_dir}", unit="sample") as bar:

@@ -24,3 +24,8 @@ class ProblemFileError(GdnplanError, ValueError):
 
 class InfeasibleProblemError(GdnplanError):
     """A problem no planner can solve as stated (start or goal in collision, goal out of reach)."""
+
+
+class OutputError(GdnplanError):
+    """An output path that cannot be written: an unknown suffix, a target that is not a regular
+    file, a parent that is not a directory, a read-only directory, a full disk."""

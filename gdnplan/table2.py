@@ -39,6 +39,7 @@ from tqdm import tqdm
 from .ccd import verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
+from .files import write_text
 from .models import CoalModel, DistanceModel, load_model
 from .rrt import rrt_connect
 from .scene import make_scene
@@ -380,15 +381,9 @@ def write(
     skipped = list(dict.fromkeys(x for r in runs for x in r.get("skipped", [])))
     header += [f"- skipped: {'; '.join(skipped) if skipped else 'none'}", ""]
     text = "\n".join(header) + "\n" + markdown(summarize(records)) + "\n\n" + NOTES
-    out.parent.mkdir(parents=True, exist_ok=True)
     record_file = {"runs": runs, "records": [asdict(r) for r in records]}
-    for path, content in (
-        (out, text),
-        (out.with_suffix(".json"), json.dumps(record_file, indent=1)),
-    ):
-        tmp = path.with_name(f".{path.name}.tmp")
-        tmp.write_text(content)
-        os.replace(tmp, path)
+    write_text(out, text, "--out")
+    write_text(out.with_suffix(".json"), json.dumps(record_file, indent=1), "--out")
     return text
 
 

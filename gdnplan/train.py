@@ -43,9 +43,10 @@ from tqdm import tqdm
 from .data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from .errors import InputError
 from .evaluate import roc_auc, sha256_prefix, used_cosine_distances
+from .files import atomic_path
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
-from .models.weights import card_path, read_card, write_json, write_tensors, write_weights
+from .models.weights import read_weights, write_weights
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS_DIR = ROOT / "weights"
@@ -232,21 +233,19 @@ def _save_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam, state
     best = state.pop("best_state", None)
     if best is not None:
         tensors.update({f"best.{k}": v for k, v in best.items()})
-    write_tensors(path, tensors)
-    write_json(card_path(path), state)
+    write_weights(path, tensors, state, "checkpoint")
     if best is not None:
         state["best_state"] = best
 
 
 def _load_checkpoint(path: Path, net: GraphDistNet, opt: torch.optim.Adam) -> dict:
-    tensors = load_file(str(path))
+    tensors, state = read_weights(path, "checkpoint")
     net.load_state_dict({k[4:]: v for k, v in tensors.items() if k.startswith("net.")})
     params = [p for g in opt.param_groups for p in g["params"]]
     for i, p in enumerate(params):
         keys = {k.split(".", 2)[2]: v for k, v in tensors.items() if k.startswith(f"opt.{i}.")}
         if keys:
             opt.state[p] = keys
-    state = read_card(path)
     for g in opt.param_groups:
         g["lr"] = state["lr"]
     best = {k[5:]: v for k, v in tensors.items() if k.startswith("best.")}
@@ -468,7 +467,8 @@ def plot_losses(log: list[dict], path: Path, title: str) -> None:
     ax.set_title(title)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100)
     plt.close(fig)
 
 

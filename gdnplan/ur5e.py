@@ -44,6 +44,7 @@ import pinocchio as pin
 
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, UnknownNameError
+from .files import atomic_path
 from .robot import (
     ROBOTS_DIR,
     Robot,
@@ -636,7 +637,8 @@ def plot_fetch(scene: Scene, q: np.ndarray, path: str) -> None:
     )
     ax.set(xlim=(-0.4, 1.3), ylim=(-0.3, 0.9), aspect="equal", xlabel="u (m)", ylabel="v (m)")
     ax.legend(loc="upper right", fontsize=7)
-    fig.savefig(path, dpi=110, bbox_inches="tight")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 

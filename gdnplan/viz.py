@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -12,6 +9,7 @@ from matplotlib.patches import Polygon as PolygonPatch
 
 from .distance import witness
 from .errors import InputError
+from .files import atomic_path
 from .scene import Scene
 
 ROBOT_COLOR = "tab:red"
@@ -61,10 +59,8 @@ def scene_figure(scene: Scene, q: np.ndarray | None = None) -> Figure:
 
 def save_figure(fig: Figure, path) -> None:
     """Write a figure atomically: render to a temporary file beside ``path``, then rename."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{path.suffix}")
-    fig.savefig(tmp, dpi=120)
-    os.replace(tmp, path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120)
 
 
 def interpolate_path(q_path: np.ndarray, per_segment: int) -> np.ndarray:
@@ -123,10 +119,8 @@ def animate_paths(
         return ()
 
     anim = FuncAnimation(fig, draw, frames=len(frames), blit=False)
-    out = Path(out)
-    tmp = out.with_name(f".{out.name}.tmp.gif")
-    anim.save(tmp, writer=PillowWriter(fps=fps))
-    os.replace(tmp, out)
+    with atomic_path(out) as tmp:
+        anim.save(tmp, writer=PillowWriter(fps=fps))
 
 
 # -------------------------------------------------------------------- Table I figures

@@ -76,3 +76,32 @@ def test_fine_tuning_keeps_the_starting_weights_when_no_epoch_beats_them(tiny_da
     assert len(log) == 2 and all(e["val_score"] > card["init"]["val_score"] for e in log)
     a, b = load_file(start), load_file(tuned)
     assert all(torch.equal(a[k], b[k]) for k in a)
+
+
+def test_a_checkpoint_killed_between_its_two_writes_is_refused(tmp_path, monkeypatch):
+    """New checkpoint tensors beside the previous epoch's state are never resumed from."""
+    import gdnplan.models.weights as w
+    from gdnplan.errors import InputError
+    from gdnplan.models.graphdistnet import GraphDistNet, GraphDistNetConfig
+    from gdnplan.train import _load_checkpoint, _save_checkpoint
+
+    net = GraphDistNet(GraphDistNetConfig.smooth().with_(layers=1))
+    opt = torch.optim.Adam(net.parameters(), lr=1e-3)
+    path = tmp_path / "checkpoint.safetensors"
+    _save_checkpoint(path, net, opt, {"epoch": 1, "lr": 1e-3, "best_state": None})
+    assert _load_checkpoint(path, net, opt)["epoch"] == 1
+    with torch.no_grad():
+        next(net.parameters()).add_(1.0)  # the next epoch's weights
+
+    def killed(*args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(w, "write_json", killed)
+    with pytest.raises(KeyboardInterrupt):
+        _save_checkpoint(path, net, opt, {"epoch": 2, "lr": 5e-4, "best_state": None})
+    with pytest.raises(InputError, match=r"^checkpoint: card checkpoint\.json does not belong"):
+        _load_checkpoint(path, net, opt)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "checkpoint.json",
+        "checkpoint.safetensors",
+    ]
