@@ -1,14 +1,27 @@
-"""The ``gdnplan`` command. Bad input prints one line (``error: …``) and exits with status 2."""
+"""The ``gdnplan`` command.
+
+Exit status: 0 success; 1 planning failed (``plan``, ``fetch``); 2 bad input (a
+:class:`~gdnplan.errors.GdnplanError` or a usage error: one line ``error: …`` naming the field and
+the fix); 3 internal error (any other exception: one line ``error: internal error (Type: message);
+rerun with --debug for the traceback``); 130 interrupted (Ctrl-C). ``gdnplan --debug <command> …``
+prints the traceback of errors 2 and 3 as well.
+"""
 
 from __future__ import annotations
 
 import json
 import sys
 import tomllib
+import traceback
 from pathlib import Path
 
 import numpy as np
 import typer
+
+try:  # typer ≥ 0.25 vendors click
+    from typer._click import exceptions as click_exceptions
+except ImportError:  # pragma: no cover - older typer depends on click
+    from click import exceptions as click_exceptions
 
 from .errors import GdnplanError, InputError, ProblemFileError
 from .scene import Scene, make_scene, scene_from_config
@@ -21,9 +34,16 @@ app = typer.Typer(
 )
 
 
+EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
+_DEBUG = {"on": False}  # set by ``--debug`` (the callback runs before the command)
+
+
 @app.callback()
-def _commands() -> None:
+def _commands(
+    debug: bool = typer.Option(False, "--debug", help="Print the traceback of any error."),
+) -> None:
     """Collision-free trajectory planning with GraphDistNet."""
+    _DEBUG["on"] = debug
 
 
 THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
@@ -459,13 +479,42 @@ def field_command(
 
 
 def run(args: list[str] | None = None) -> None:
-    """Run the app on ``args`` (default: the command line), turning GdnplanError into one line
-    and exit code 2."""
+    """Run the app on ``args`` (default: the command line); exits with the status of the module
+    docstring, every error as one line on stderr."""
+    _DEBUG["on"] = False
     try:
-        app(args=args, prog_name="gdnplan")
+        code = app(args=args, prog_name="gdnplan", standalone_mode=False)
+        if code == EXIT_INTERRUPTED:  # typer returns Ctrl-C in a command as exit code 130
+            typer.echo("error: interrupted", err=True)
+    except click_exceptions.NoArgsIsHelpError as e:
+        e.show()
+        code = EXIT_INPUT
+    except click_exceptions.UsageError as e:
+        hint = f"; see `{e.ctx.command_path} --help`" if e.ctx is not None else ""
+        code = _fail(e, one_line(e.format_message()) + hint, EXIT_INPUT)
     except GdnplanError as e:
-        typer.echo(f"error: {e}", err=True)
-        sys.exit(2)
+        code = _fail(e, one_line(str(e)), EXIT_INPUT)
+    except (KeyboardInterrupt, typer.Abort) as e:
+        code = _fail(e, "interrupted", EXIT_INTERRUPTED)
+    except Exception as e:  # the last resort: a bug, never a traceback without --debug
+        why = f"{type(e).__name__}: {one_line(str(e))}" if str(e) else type(e).__name__
+        message = f"internal error ({why}); rerun with --debug for the traceback"
+        code = _fail(e, message, EXIT_INTERNAL)
+    sys.exit(code if isinstance(code, int) else 0)
+
+
+def _fail(e: BaseException, message: str, code: int) -> int:
+    """Print ``error: message`` (after the traceback with ``--debug``); returns ``code``."""
+    if _DEBUG["on"]:
+        traceback.print_exception(e)
+    typer.echo(f"error: {message}", err=True)
+    return code
+
+
+def one_line(text: str, limit: int = 400) -> str:
+    """``text`` on one line (whitespace runs become one space), at most ``limit`` characters."""
+    flat = " ".join(text.split())
+    return flat if len(flat) <= limit else flat[: limit - 1] + "…"
 
 
 def main() -> None:
