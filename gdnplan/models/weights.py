@@ -13,9 +13,10 @@ import os
 from pathlib import Path
 
 import torch
-from safetensors.torch import load_file, save_file
+from safetensors.torch import save_file
 
 from ..errors import InputError
+from .checks import load_tensors, parse_card
 
 
 def card_path(path: Path | str) -> Path:
@@ -28,7 +29,7 @@ def read_card(path: Path | str, what: str = "weights") -> dict:
     card = card_path(path)
     if not card.exists():
         raise InputError(f"{what}: no card {card.name} beside {path}")
-    return json.loads(card.read_text())
+    return parse_card(card, what)
 
 
 def read_weights(path: Path | str) -> tuple[dict[str, torch.Tensor], dict]:
@@ -37,7 +38,7 @@ def read_weights(path: Path | str) -> tuple[dict[str, torch.Tensor], dict]:
     if not path.exists():
         raise InputError(f"weights: {path} not found")
     card = read_card(path)
-    return load_file(str(path)), card
+    return load_tensors(path), card
 
 
 def write_json(path: Path | str, obj: dict) -> None:
