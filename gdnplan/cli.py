@@ -89,7 +89,7 @@ def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
 def show(
     target: str = typer.Argument(..., help="A problem TOML file or a scene name (a-e, fetch)."),
     q: str = typer.Option(None, help="Joint angles 'q1,q2,...' (default: the problem's start)."),
-    seed: int = typer.Option(0, help="Scene seed, for generated scenes."),
+    seed: int = typer.Option(0, min=0, help="Scene seed, for generated scenes."),
     out: Path = typer.Option(Path("scene.png"), help="Output PNG."),
 ) -> None:
     """Draw the robot, the obstacles and the witness segment of the signed distance."""
@@ -110,7 +110,7 @@ def plan_command(
     collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
     solver: str = typer.Option("ipopt", help="ipopt (direct transcription) or adam (paper)."),
     weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/<env>)."),
-    seed: int = typer.Option(0, help="Seed of the sampling-based initial guesses."),
+    seed: int = typer.Option(0, min=0, help="Seed of the sampling-based initial guesses."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
     threads: int = typer.Option(1, help=THREADS_HELP),
@@ -178,8 +178,8 @@ EVAL_MODELS = ("coal", "diffco", "clearancenet", "graphdistnet")
 def evaluate_command(
     env: str = typer.Option("a", help="Environment a-e (its held-out split, seed 1)."),
     model: str = typer.Option("graphdistnet", help="coal | diffco | clearancenet | graphdistnet."),
-    n: int = typer.Option(5000, help="Held-out samples (time, MAE, AUC)."),
-    n_grad: int = typer.Option(5000, help="Samples for the ACD (the first of the n)."),
+    n: int = typer.Option(5000, min=1, max=5000, help="Held-out samples (time, MAE, AUC)."),
+    n_grad: int = typer.Option(5000, min=1, help="Samples for the ACD (the first of the n)."),
 ) -> None:
     """Time, MAE, AUC and ACD of one collision model on held-out samples (Table I metrics)."""
     from . import evaluate as ev
@@ -187,6 +187,8 @@ def evaluate_command(
 
     if model not in EVAL_MODELS:
         raise InputError(f"--model: unknown {model!r}; choose one of {list(EVAL_MODELS)}")
+    if env not in ev.ENVS:
+        raise InputError(f"--env: expected one of {list(ev.ENVS)}, got {env!r}")
     if model == "coal":
         from .models import CoalModel
 
@@ -263,8 +265,8 @@ def table2_command(
         "GraphDistNet,ClearanceNet,DiffCo,coal", help="Collision models (comma-separated)."
     ),
     solvers: str = typer.Option("ipopt,adam", help="Optimisers: ipopt, adam (comma-separated)."),
-    seed: int = typer.Option(0, help="Problem seed."),
-    first: int = typer.Option(0, help="Run problems first … n − 1 only (split a run)."),
+    seed: int = typer.Option(0, min=0, help="Problem seed."),
+    first: int = typer.Option(0, min=0, help="Run problems first … n − 1 only (split a run)."),
     threads: int = typer.Option(1, help=THREADS_HELP),
     out: Path = typer.Option(Path("results/table2.md"), help="Markdown output (+ .json)."),
     update: bool = typer.Option(
@@ -285,6 +287,8 @@ def table2_command(
             raise InputError(f"--{name}: expected some of {allowed[name]}, got {bad or values}")
     if n < 1:
         raise InputError(f"--n: expected ≥ 1, got {n}")
+    if first >= n:
+        raise InputError(f"--first: expected a problem index below --n {n}, got {first}")
     set_threads(threads)
     records, skipped = [], []
     for setting in chosen["settings"]:
@@ -309,7 +313,7 @@ def table2_command(
 
 @app.command("fetch")
 def fetch_command(
-    seed: int = typer.Option(0, help="Fetch layout: 0 canonical, others random storages."),
+    seed: int = typer.Option(0, min=0, help="Fetch layout: 0 canonical, others random storages."),
     collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
     weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/ur5e)."),
     animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
@@ -364,14 +368,14 @@ def fetch_command(
 def generate_command(
     env: str = typer.Option(..., help="Environment: a-e or ur5e."),
     split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
-    n: int = typer.Option(None, help="Samples (default: the paper's 50 000 / 5 000)."),
-    seed: int = typer.Option(None, help="Override the split's seed."),
+    n: int = typer.Option(None, min=1, help="Samples (default: the paper's 50 000 / 5 000)."),
+    seed: int = typer.Option(None, min=0, help="Override the split's seed."),
     near: float = typer.Option(
         0.0,
         help="Fraction of samples drawn near contact: around the fetch task (ur5e), "
         "|f| < 3 cm (a-e).",
     ),
-    workers: int = typer.Option(None, help="Worker processes (default: all cores)."),
+    workers: int = typer.Option(None, min=1, help="Worker processes (default: all cores)."),
     data: Path = typer.Option(None, help="Data root (default data/): <data>/<env>/<split>."),
 ) -> None:
     """Write a dataset of graphs and coal labels in resumable shards (finished shards are kept)."""
@@ -381,7 +385,9 @@ def generate_command(
         raise InputError(f"--split: expected one of {sorted(SPLITS)}, got {split!r}")
     split_seed, size = SPLITS[split]
     target = split_dir(env, split, data or DATA_DIR)
-    generate(env, n or size, split_seed if seed is None else seed, target, workers, near)
+    generate(
+        env, size if n is None else n, split_seed if seed is None else seed, target, workers, near
+    )
     typer.echo(f"wrote {target}")
 
 
@@ -392,13 +398,15 @@ def train_command(
     preset: str = typer.Option("smooth", help="GraphDistNet: smooth (planner) or faithful."),
     name: str = typer.Option(None, help="Run name, runs/<env>-<name> (default: the preset)."),
     set_: list[str] = typer.Option([], "--set", help="Config override key=json_value."),
-    n_train: int = typer.Option(None, help="Use only the first n training samples."),
-    batch: int = typer.Option(256, help="Batch size."),
-    lr: float = typer.Option(1e-3, help="Adam learning rate."),
-    epochs: int = typer.Option(200, help="Epoch cap."),
-    patience: int = typer.Option(10, help="Early stopping: epochs without improvement."),
-    time_budget: float = typer.Option(None, help="Seconds of training."),
-    seed: int = typer.Option(0, help="Random seed."),
+    n_train: int = typer.Option(
+        None, min=2, help="Use only the first n training samples (≥ 2: 10 % validate)."
+    ),
+    batch: int = typer.Option(256, min=1, help="Batch size."),
+    lr: float = typer.Option(1e-3, help="Adam learning rate (≥ 0; 0 keeps --init's weights)."),
+    epochs: int = typer.Option(200, min=1, help="Epoch cap."),
+    patience: int = typer.Option(10, min=1, help="Early stopping: epochs without improvement."),
+    time_budget: float = typer.Option(None, help="Seconds of training (> 0)."),
+    seed: int = typer.Option(0, min=0, help="Random seed."),
     device: str = typer.Option("cpu", help="cpu or cuda."),
     threads: int = typer.Option(1, help="torch threads."),
     data: Path = typer.Option(None, help="Data root (default: data/)."),
@@ -413,6 +421,9 @@ def train_command(
     ),
 ) -> None:
     """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
+    from .train import check_options
+
+    check_options(n_train, batch, lr, epochs, patience, time_budget, device)
     if model == "clearancenet":
         from .models.clearancenet import train_and_save
 
@@ -433,7 +444,12 @@ def train_command(
     except ValueError as e:
         raise InputError(f"--set: expected key=json_value, got {set_}") from e
     base = PRESETS[preset]().to_dict() if init is None else _card_config(init)
-    config = GraphDistNetConfig.from_dict(base | overrides)
+    try:
+        config = GraphDistNetConfig.from_dict(base | overrides)
+    except (TypeError, ValueError) as e:
+        if isinstance(e, InputError):
+            raise InputError(f"--set: {e}") from e
+        raise InputError(f"--set: a value of the wrong type in {set_} ({e})") from e
     set_threads(threads)
     card = train(
         env,
@@ -461,19 +477,27 @@ def _card_config(weights: Path) -> dict:
     """The config of the JSON card beside ``weights`` (InputError when it is missing)."""
     from .models.weights import read_card
 
-    return read_card(weights, "--init")["config"]
+    config = read_card(weights, "--init").get("config")
+    if not isinstance(config, dict):
+        raise InputError(f"--init: the card of {weights} has no 'config' object")
+    return config
+
+
+FIELD_GRID_MAX = 1001  # 10⁶ configurations, minutes per model
 
 
 @app.command("field")
 def field_command(
     env: str = typer.Option("a", help="A 2-DoF environment (a or b)."),
     out: Path = typer.Option(Path("field.png"), help="Output PNG."),
-    grid: int = typer.Option(101, help="Grid points per joint."),
+    grid: int = typer.Option(101, min=2, max=FIELD_GRID_MAX, help="Grid points per joint."),
 ) -> None:
     """The paper's Fig. 5: distance fields over (q1, q2) from coal, DiffCo and GraphDistNet."""
     from .evaluate import fig5
     from .viz import save_figure
 
+    if env not in ("a", "b"):
+        raise InputError(f"--env: expected a 2-DoF environment, a or b, got {env!r}")
     save_figure(fig5(env, grid), out)
     typer.echo(f"wrote {out}")
 

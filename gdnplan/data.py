@@ -360,10 +360,10 @@ def generate(
         raise UnknownNameError(f"env: unknown environment {env!r}; choose one of {list(ENVS)}")
     if n < 1:
         raise InputError(f"n: expected a positive number of samples, got {n}")
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     if not 0.0 <= near <= 1.0:
         raise InputError(f"near: expected a fraction in [0, 1], got {near}")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
     jobs = [
         (env, seed, s, k, str(p), near) for s, k, p in shard_paths(out_dir, n) if not p.exists()
     ]
