@@ -23,8 +23,8 @@ try:  # typer ≥ 0.25 vendors click
 except ImportError:  # pragma: no cover - older typer depends on click
     from click import exceptions as click_exceptions
 
-from .errors import GdnplanError, InputError, ProblemFileError
-from .scene import Scene, make_scene, scene_from_config
+from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
+from .scene import Scene, make_scene, scene_from_config, scene_names
 
 app = typer.Typer(
     help="Collision-free trajectory planning with GraphDistNet.",
@@ -67,22 +67,73 @@ def parse_vector(text: str, name: str) -> np.ndarray:
 
 
 def read_toml(path: Path) -> dict:
-    """Parse a TOML file; raises ProblemFileError with the parser's line and column."""
+    """Parse a TOML file; ProblemFileError when it is unreadable, not UTF-8 or malformed (with
+    the parser's line and column)."""
     if not path.exists():
         raise ProblemFileError(f"{path}: no such file")
     try:
-        return tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_bytes().decode("utf-8"))
+    except OSError as e:
+        raise ProblemFileError(f"{path}: cannot read the problem file ({e.strerror})") from e
+    except UnicodeDecodeError as e:
+        raise ProblemFileError(
+            f"{path}: not a UTF-8 text file ({e.reason} at byte {e.start})"
+        ) from e
+    except RecursionError as e:
+        raise ProblemFileError(f"{path}: malformed TOML (nested too deeply)") from e
     except tomllib.TOMLDecodeError as e:
         raise ProblemFileError(f"{path}: malformed TOML ({e})") from e
 
 
 def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
     """A scene from a problem TOML file (with its start q) or from a generator name."""
-    if target.endswith(".toml"):
-        cfg = read_toml(Path(target))
-        start = cfg.get("start", {}).get("q")
-        return scene_from_config(cfg), None if start is None else np.asarray(start, float)
+    if target.endswith(".toml") or (target not in scene_names() and Path(target).exists()):
+        return problem_scene_and_start(Path(target))
     return make_scene(target, seed=seed), None
+
+
+def problem_scene_and_start(path: Path) -> tuple[Scene, np.ndarray | None]:
+    """The scene and ``[start] q`` of a problem file, checked as ``plan`` checks it.
+
+    A file with a ``[goal]`` passes every check of :meth:`Problem.from_config` except the
+    feasibility ones (a start in collision is what ``show`` draws); a scene-only file (no
+    ``[goal]``, ``[start]`` optional) the checks of its tables. ProblemFileError names the file.
+    """
+    from .trajopt import TOP_KEYS, Problem, _no_unknown, _vector
+
+    cfg = read_toml(path)
+    try:
+        if "goal" in cfg:
+            try:
+                Problem.from_config(cfg)
+            except InfeasibleProblemError:
+                pass
+        _no_unknown(cfg, TOP_KEYS, "top level")
+        try:
+            scene = scene_from_config(cfg)
+        except TypeError as e:
+            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
+        start = cfg.get("start")
+        if start is None:
+            return scene, None
+        if not isinstance(start, dict) or "q" not in start:
+            raise ProblemFileError("[start]: expected a table with q = [start joint angles]")
+        q = _vector(start["q"], scene.robot.dof, "start.q")
+        return scene, check_limits(scene.robot, q, "start.q")
+    except GdnplanError as e:
+        raise ProblemFileError(f"{path}: {e}") from e
+
+
+def check_limits(robot, q: np.ndarray, name: str) -> np.ndarray:
+    """``q`` (dof,) when it is within the robot's joint limits; InputError naming the joint."""
+    bad = np.flatnonzero((q < robot.lower - 1e-9) | (q > robot.upper + 1e-9))
+    if bad.size:
+        j = int(bad[0])
+        raise InputError(
+            f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
+            f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}] of {robot.name}"
+        )
+    return q
 
 
 @app.command()
@@ -96,9 +147,12 @@ def show(
     from .viz import save_figure, scene_figure
 
     scene, start = scene_and_start(target, seed)
-    config = parse_vector(q, "--q") if q is not None else start
-    if config is not None:
-        config = scene.robot.check_q(config, "--q")[0]
+    if q is not None:
+        config = check_limits(
+            scene.robot, scene.robot.check_q(parse_vector(q, "--q"), "--q")[0], "--q"
+        )
+    else:
+        config = start
     fig = scene_figure(scene, config)
     save_figure(fig, out)
     typer.echo(f"wrote {out}")
