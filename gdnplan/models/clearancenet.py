@@ -189,6 +189,12 @@ class ClearanceNetModel:
         return np.concatenate(ds), (np.concatenate(gs) if grad else None)
 
     def _scene_vector(self, scene: Scene, b: int) -> np.ndarray:
+        self.check_scene(scene)
+        polys, sizes = pad_polygons([list(scene.obstacles)])
+        return np.repeat(obstacle_vector(self.net.config, polys, sizes), b, 0)
+
+    def check_scene(self, scene: Scene) -> None:
+        """InputError unless the weights fit ``scene``'s robot and obstacles (models/checks.py)."""
         config = self.net.config
         check_fits(self.card, scene, config.dof)
         check_layout(self.card, scene, lambda: make_scene(config.env))
@@ -197,8 +203,6 @@ class ClearanceNetModel:
                 f"obstacles: ClearanceNet of env {config.env} encodes squares by their pose; "
                 "this scene has other polygons (use GraphDistNet or coal)"
             )
-        polys, sizes = pad_polygons([list(scene.obstacles)])
-        return np.repeat(obstacle_vector(self.net.config, polys, sizes), b, 0)
 
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
         q = scene.robot.check_q(q)

@@ -939,11 +939,15 @@ class GraphDistNetModel:
         self.device = torch.device(device)
         self._scenes: weakref.WeakKeyDictionary[Scene, _SceneCache] = weakref.WeakKeyDictionary()
 
+    def check_scene(self, scene: Scene) -> None:
+        """InputError unless the weights were trained for ``scene``'s robot (models/checks.py)."""
+        check_fits(self.card, scene)
+
     def _graphs(self, scene: Scene) -> _SceneCache:
         """The (cached) robot graph, obstacle graph and lean scene graph of ``scene``."""
         cached = self._scenes.get(scene)
         if cached is None:
-            check_fits(self.card, scene)
+            self.check_scene(scene)
             graph = robot_graph(scene.robot, self.config.max_edge)
             polys, sizes = scene_obstacles([scene])
             obstacles = obstacle_graph(
