@@ -1,18 +1,31 @@
-"""The ``gdnplan`` command. Bad input prints one line (``error: …``) and exits with status 2."""
+"""The ``gdnplan`` command.
+
+Exit status: 0 success; 1 planning failed (``plan``, ``fetch``); 2 bad input (a
+:class:`~gdnplan.errors.GdnplanError` or a usage error: one line ``error: …`` naming the field and
+the fix); 3 internal error (any other exception: one line ``error: internal error (Type: message);
+rerun with --debug for the traceback``); 130 interrupted (Ctrl-C). ``gdnplan --debug <command> …``
+prints the traceback of errors 2 and 3 as well.
+"""
 
 from __future__ import annotations
 
 import json
 import sys
 import tomllib
+import traceback
 from pathlib import Path
 
 import numpy as np
 import typer
 
-from .errors import GdnplanError, InputError, ProblemFileError
+try:  # typer ≥ 0.25 vendors click
+    from typer._click import exceptions as click_exceptions
+except ImportError:  # pragma: no cover - older typer depends on click
+    from click import exceptions as click_exceptions
+
+from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
 from .files import FIGURE_SUFFIXES, check_output_dir, check_output_path, write_text
-from .scene import Scene, make_scene, scene_from_config
+from .scene import Scene, make_scene, scene_from_config, scene_names
 
 app = typer.Typer(
     help="Collision-free trajectory planning with GraphDistNet.",
@@ -22,9 +35,16 @@ app = typer.Typer(
 )
 
 
+EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
+_DEBUG = {"on": False}  # set by ``--debug`` (the callback runs before the command)
+
+
 @app.callback()
-def _commands() -> None:
+def _commands(
+    debug: bool = typer.Option(False, "--debug", help="Print the traceback of any error."),
+) -> None:
     """Collision-free trajectory planning with GraphDistNet."""
+    _DEBUG["on"] = debug
 
 
 THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
@@ -48,29 +68,80 @@ def parse_vector(text: str, name: str) -> np.ndarray:
 
 
 def read_toml(path: Path) -> dict:
-    """Parse a TOML file; raises ProblemFileError with the parser's line and column."""
+    """Parse a TOML file; ProblemFileError when it is unreadable, not UTF-8 or malformed (with
+    the parser's line and column)."""
     if not path.exists():
         raise ProblemFileError(f"{path}: no such file")
     try:
-        return tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_bytes().decode("utf-8"))
+    except OSError as e:
+        raise ProblemFileError(f"{path}: cannot read the problem file ({e.strerror})") from e
+    except UnicodeDecodeError as e:
+        raise ProblemFileError(
+            f"{path}: not a UTF-8 text file ({e.reason} at byte {e.start})"
+        ) from e
+    except RecursionError as e:
+        raise ProblemFileError(f"{path}: malformed TOML (nested too deeply)") from e
     except tomllib.TOMLDecodeError as e:
         raise ProblemFileError(f"{path}: malformed TOML ({e})") from e
 
 
 def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
     """A scene from a problem TOML file (with its start q) or from a generator name."""
-    if target.endswith(".toml"):
-        cfg = read_toml(Path(target))
-        start = cfg.get("start", {}).get("q")
-        return scene_from_config(cfg), None if start is None else np.asarray(start, float)
+    if target.endswith(".toml") or (target not in scene_names() and Path(target).exists()):
+        return problem_scene_and_start(Path(target))
     return make_scene(target, seed=seed), None
+
+
+def problem_scene_and_start(path: Path) -> tuple[Scene, np.ndarray | None]:
+    """The scene and ``[start] q`` of a problem file, checked as ``plan`` checks it.
+
+    A file with a ``[goal]`` passes every check of :meth:`Problem.from_config` except the
+    feasibility ones (a start in collision is what ``show`` draws); a scene-only file (no
+    ``[goal]``, ``[start]`` optional) the checks of its tables. ProblemFileError names the file.
+    """
+    from .trajopt import TOP_KEYS, Problem, _no_unknown, _vector
+
+    cfg = read_toml(path)
+    try:
+        if "goal" in cfg:
+            try:
+                Problem.from_config(cfg)
+            except InfeasibleProblemError:
+                pass
+        _no_unknown(cfg, TOP_KEYS, "top level")
+        try:
+            scene = scene_from_config(cfg)
+        except TypeError as e:
+            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
+        start = cfg.get("start")
+        if start is None:
+            return scene, None
+        if not isinstance(start, dict) or "q" not in start:
+            raise ProblemFileError("[start]: expected a table with q = [start joint angles]")
+        q = _vector(start["q"], scene.robot.dof, "start.q")
+        return scene, check_limits(scene.robot, q, "start.q")
+    except GdnplanError as e:
+        raise ProblemFileError(f"{path}: {e}") from e
+
+
+def check_limits(robot, q: np.ndarray, name: str) -> np.ndarray:
+    """``q`` (dof,) when it is within the robot's joint limits; InputError naming the joint."""
+    bad = np.flatnonzero((q < robot.lower - 1e-9) | (q > robot.upper + 1e-9))
+    if bad.size:
+        j = int(bad[0])
+        raise InputError(
+            f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
+            f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}] of {robot.name}"
+        )
+    return q
 
 
 @app.command()
 def show(
     target: str = typer.Argument(..., help="A problem TOML file or a scene name (a-e, fetch)."),
     q: str = typer.Option(None, help="Joint angles 'q1,q2,...' (default: the problem's start)."),
-    seed: int = typer.Option(0, help="Scene seed, for generated scenes."),
+    seed: int = typer.Option(0, min=0, help="Scene seed, for generated scenes."),
     out: Path = typer.Option(Path("scene.png"), help="Output PNG."),
 ) -> None:
     """Draw the robot, the obstacles and the witness segment of the signed distance."""
@@ -78,9 +149,12 @@ def show(
 
     check_output_path(out, FIGURE_SUFFIXES, "--out")
     scene, start = scene_and_start(target, seed)
-    config = parse_vector(q, "--q") if q is not None else start
-    if config is not None:
-        config = scene.robot.check_q(config, "--q")[0]
+    if q is not None:
+        config = check_limits(
+            scene.robot, scene.robot.check_q(parse_vector(q, "--q"), "--q")[0], "--q"
+        )
+    else:
+        config = start
     fig = scene_figure(scene, config)
     save_figure(fig, out)
     typer.echo(f"wrote {out}")
@@ -92,7 +166,7 @@ def plan_command(
     collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
     solver: str = typer.Option("ipopt", help="ipopt (direct transcription) or adam (paper)."),
     weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/<env>)."),
-    seed: int = typer.Option(0, help="Seed of the sampling-based initial guesses."),
+    seed: int = typer.Option(0, min=0, help="Seed of the sampling-based initial guesses."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
     threads: int = typer.Option(1, help=THREADS_HELP),
@@ -175,8 +249,8 @@ EVAL_MODELS = ("coal", "diffco", "clearancenet", "graphdistnet")
 def evaluate_command(
     env: str = typer.Option("a", help="Environment a-e (its held-out split, seed 1)."),
     model: str = typer.Option("graphdistnet", help="coal | diffco | clearancenet | graphdistnet."),
-    n: int = typer.Option(5000, help="Held-out samples (time, MAE, AUC)."),
-    n_grad: int = typer.Option(5000, help="Samples for the ACD (the first of the n)."),
+    n: int = typer.Option(5000, min=1, max=5000, help="Held-out samples (time, MAE, AUC)."),
+    n_grad: int = typer.Option(5000, min=1, help="Samples for the ACD (the first of the n)."),
 ) -> None:
     """Time, MAE, AUC and ACD of one collision model on held-out samples (Table I metrics)."""
     from . import evaluate as ev
@@ -184,6 +258,8 @@ def evaluate_command(
 
     if model not in EVAL_MODELS:
         raise InputError(f"--model: unknown {model!r}; choose one of {list(EVAL_MODELS)}")
+    if env not in ev.ENVS:
+        raise InputError(f"--env: expected one of {list(ev.ENVS)}, got {env!r}")
     if model == "coal":
         from .models import CoalModel
 
@@ -260,8 +336,8 @@ def table2_command(
         "GraphDistNet,ClearanceNet,DiffCo,coal", help="Collision models (comma-separated)."
     ),
     solvers: str = typer.Option("ipopt,adam", help="Optimisers: ipopt, adam (comma-separated)."),
-    seed: int = typer.Option(0, help="Problem seed."),
-    first: int = typer.Option(0, help="Run problems first … n − 1 only (split a run)."),
+    seed: int = typer.Option(0, min=0, help="Problem seed."),
+    first: int = typer.Option(0, min=0, help="Run problems first … n − 1 only (split a run)."),
     threads: int = typer.Option(1, help=THREADS_HELP),
     out: Path = typer.Option(Path("results/table2.md"), help="Markdown output (+ .json)."),
     update: bool = typer.Option(
@@ -284,6 +360,8 @@ def table2_command(
             raise InputError(f"--{name}: expected some of {allowed[name]}, got {bad or values}")
     if n < 1:
         raise InputError(f"--n: expected ≥ 1, got {n}")
+    if first >= n:
+        raise InputError(f"--first: expected a problem index below --n {n}, got {first}")
     set_threads(threads)
     records, skipped = [], []
     for setting in chosen["settings"]:
@@ -308,7 +386,7 @@ def table2_command(
 
 @app.command("fetch")
 def fetch_command(
-    seed: int = typer.Option(0, help="Fetch layout: 0 canonical, others random storages."),
+    seed: int = typer.Option(0, min=0, help="Fetch layout: 0 canonical, others random storages."),
     collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
     weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/ur5e)."),
     animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
@@ -365,14 +443,14 @@ def fetch_command(
 def generate_command(
     env: str = typer.Option(..., help="Environment: a-e or ur5e."),
     split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
-    n: int = typer.Option(None, help="Samples (default: the paper's 50 000 / 5 000)."),
-    seed: int = typer.Option(None, help="Override the split's seed."),
+    n: int = typer.Option(None, min=1, help="Samples (default: the paper's 50 000 / 5 000)."),
+    seed: int = typer.Option(None, min=0, help="Override the split's seed."),
     near: float = typer.Option(
         0.0,
         help="Fraction of samples drawn near contact: around the fetch task (ur5e), "
         "|f| < 3 cm (a-e).",
     ),
-    workers: int = typer.Option(None, help="Worker processes (default: all cores)."),
+    workers: int = typer.Option(None, min=1, help="Worker processes (default: all cores)."),
     data: Path = typer.Option(None, help="Data root (default data/): <data>/<env>/<split>."),
 ) -> None:
     """Write a dataset of graphs and coal labels in resumable shards (finished shards are kept)."""
@@ -382,7 +460,9 @@ def generate_command(
         raise InputError(f"--split: expected one of {sorted(SPLITS)}, got {split!r}")
     split_seed, size = SPLITS[split]
     target = check_output_dir(split_dir(env, split, data or DATA_DIR), "--data")
-    generate(env, n or size, split_seed if seed is None else seed, target, workers, near)
+    generate(
+        env, size if n is None else n, split_seed if seed is None else seed, target, workers, near
+    )
     typer.echo(f"wrote {target}")
 
 
@@ -393,13 +473,15 @@ def train_command(
     preset: str = typer.Option("smooth", help="GraphDistNet: smooth (planner) or faithful."),
     name: str = typer.Option(None, help="Run name, runs/<env>-<name> (default: the preset)."),
     set_: list[str] = typer.Option([], "--set", help="Config override key=json_value."),
-    n_train: int = typer.Option(None, help="Use only the first n training samples."),
-    batch: int = typer.Option(256, help="Batch size."),
-    lr: float = typer.Option(1e-3, help="Adam learning rate."),
-    epochs: int = typer.Option(200, help="Epoch cap."),
-    patience: int = typer.Option(10, help="Early stopping: epochs without improvement."),
-    time_budget: float = typer.Option(None, help="Seconds of training."),
-    seed: int = typer.Option(0, help="Random seed."),
+    n_train: int = typer.Option(
+        None, min=2, help="Use only the first n training samples (≥ 2: 10 % validate)."
+    ),
+    batch: int = typer.Option(256, min=1, help="Batch size."),
+    lr: float = typer.Option(1e-3, help="Adam learning rate (≥ 0; 0 keeps --init's weights)."),
+    epochs: int = typer.Option(200, min=1, help="Epoch cap."),
+    patience: int = typer.Option(10, min=1, help="Early stopping: epochs without improvement."),
+    time_budget: float = typer.Option(None, help="Seconds of training (> 0)."),
+    seed: int = typer.Option(0, min=0, help="Random seed."),
     device: str = typer.Option("cpu", help="cpu or cuda."),
     threads: int = typer.Option(1, help="torch threads."),
     data: Path = typer.Option(None, help="Data root (default: data/)."),
@@ -414,6 +496,9 @@ def train_command(
     ),
 ) -> None:
     """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
+    from .train import check_options
+
+    check_options(n_train, batch, lr, epochs, patience, time_budget, device)
     if out is not None:
         check_output_path(out, (".safetensors",), "--out")
         check_output_path(out.with_suffix(".json"), (".json",), "--out")
@@ -439,7 +524,12 @@ def train_command(
     except ValueError as e:
         raise InputError(f"--set: expected key=json_value, got {set_}") from e
     base = PRESETS[preset]().to_dict() if init is None else _card_config(init)
-    config = GraphDistNetConfig.from_dict(base | overrides)
+    try:
+        config = GraphDistNetConfig.from_dict(base | overrides)
+    except (TypeError, ValueError) as e:
+        if isinstance(e, InputError):
+            raise InputError(f"--set: {e}") from e
+        raise InputError(f"--set: a value of the wrong type in {set_} ({e})") from e
     set_threads(threads)
     card = train(
         env,
@@ -467,32 +557,69 @@ def _card_config(weights: Path) -> dict:
     """The config of the JSON card beside ``weights`` (InputError when it is missing)."""
     from .models.weights import read_card
 
-    return read_card(weights, "--init")["config"]
+    config = read_card(weights, "--init").get("config")
+    if not isinstance(config, dict):
+        raise InputError(f"--init: the card of {weights} has no 'config' object")
+    return config
+
+
+FIELD_GRID_MAX = 1001  # 10⁶ configurations, minutes per model
 
 
 @app.command("field")
 def field_command(
     env: str = typer.Option("a", help="A 2-DoF environment (a or b)."),
     out: Path = typer.Option(Path("field.png"), help="Output PNG."),
-    grid: int = typer.Option(101, help="Grid points per joint."),
+    grid: int = typer.Option(101, min=2, max=FIELD_GRID_MAX, help="Grid points per joint."),
 ) -> None:
     """The paper's Fig. 5: distance fields over (q1, q2) from coal, DiffCo and GraphDistNet."""
     from .evaluate import fig5
     from .viz import save_figure
 
+    if env not in ("a", "b"):
+        raise InputError(f"--env: expected a 2-DoF environment, a or b, got {env!r}")
     check_output_path(out, FIGURE_SUFFIXES, "--out")
     save_figure(fig5(env, grid), out)
     typer.echo(f"wrote {out}")
 
 
 def run(args: list[str] | None = None) -> None:
-    """Run the app on ``args`` (default: the command line), turning GdnplanError into one line
-    and exit code 2."""
+    """Run the app on ``args`` (default: the command line); exits with the status of the module
+    docstring, every error as one line on stderr."""
+    _DEBUG["on"] = False
     try:
-        app(args=args, prog_name="gdnplan")
+        code = app(args=args, prog_name="gdnplan", standalone_mode=False)
+        if code == EXIT_INTERRUPTED:  # typer returns Ctrl-C in a command as exit code 130
+            typer.echo("error: interrupted", err=True)
+    except click_exceptions.NoArgsIsHelpError as e:
+        e.show()
+        code = EXIT_INPUT
+    except click_exceptions.UsageError as e:
+        hint = f"; see `{e.ctx.command_path} --help`" if e.ctx is not None else ""
+        code = _fail(e, one_line(e.format_message()) + hint, EXIT_INPUT)
     except GdnplanError as e:
-        typer.echo(f"error: {e}", err=True)
-        sys.exit(2)
+        code = _fail(e, one_line(str(e)), EXIT_INPUT)
+    except (KeyboardInterrupt, typer.Abort) as e:
+        code = _fail(e, "interrupted", EXIT_INTERRUPTED)
+    except Exception as e:  # the last resort: a bug, never a traceback without --debug
+        why = f"{type(e).__name__}: {one_line(str(e))}" if str(e) else type(e).__name__
+        message = f"internal error ({why}); rerun with --debug for the traceback"
+        code = _fail(e, message, EXIT_INTERNAL)
+    sys.exit(code if isinstance(code, int) else 0)
+
+
+def _fail(e: BaseException, message: str, code: int) -> int:
+    """Print ``error: message`` (after the traceback with ``--debug``); returns ``code``."""
+    if _DEBUG["on"]:
+        traceback.print_exception(e)
+    typer.echo(f"error: {message}", err=True)
+    return code
+
+
+def one_line(text: str, limit: int = 400) -> str:
+    """``text`` on one line (whitespace runs become one space), at most ``limit`` characters."""
+    flat = " ".join(text.split())
+    return flat if len(flat) <= limit else flat[: limit - 1] + "…"
 
 
 def main() -> None:

@@ -284,6 +284,69 @@ def save_weights(net: GraphDistNet, card: dict, path: Path | str) -> Path:
 load_weights = load_graphdistnet  # weights/<env>.safetensors -> GraphDistNetModel
 
 
+def check_options(
+    n_train: int | None,
+    batch: int,
+    lr: float,
+    epochs: int,
+    patience: int,
+    time_budget: float | None,
+    device: str,
+) -> None:
+    """InputError naming the option unless the training options of :func:`train` are usable."""
+    for name, value, least in (("n_train", n_train, 2), ("batch", batch, 1), ("epochs", epochs, 1),
+                               ("patience", patience, 1)):  # fmt: skip
+        if value is not None and (not isinstance(value, int) or value < least):
+            raise InputError(f"{name}: expected an integer ≥ {least}, got {value!r}")
+    if not (isinstance(lr, (int, float)) and math.isfinite(lr) and lr >= 0):
+        raise InputError(f"lr: expected a finite learning rate ≥ 0, got {lr!r}")
+    if time_budget is not None and not (
+        isinstance(time_budget, (int, float)) and math.isfinite(time_budget) and time_budget > 0
+    ):
+        raise InputError(
+            f"time_budget: expected a finite number of seconds > 0, got {time_budget!r}"
+        )
+    try:
+        dev = torch.device(device)
+    except (RuntimeError, TypeError) as e:
+        raise InputError(f"device: expected cpu or cuda, got {device!r}") from e
+    if dev.type not in ("cpu", "cuda"):
+        raise InputError(f"device: expected cpu or cuda, got {device!r}")
+    if dev.type == "cuda" and (dev.index or 0) >= torch.cuda.device_count():
+        raise InputError(f"device: {device} is not available on this machine; use cpu")
+
+
+def check_env(ds: Dataset, env: str, where: Path | str) -> Dataset:
+    """``ds`` when its samples are of environment ``env``; InputError naming both otherwise."""
+    if ds.env != env:
+        raise InputError(
+            f"data: {where} holds samples of environment {ds.env!r}, not {env!r}; generate "
+            f"them with `gdnplan generate --env {env}` or train with --env {ds.env}"
+        )
+    return ds
+
+
+RESUME_KEYS = ("config", "batch", "lr", "seed", "n_train", "extra")
+
+
+def check_resume(state: dict, settings: dict, ckpt: Path) -> None:
+    """InputError naming the settings that differ from those the checkpoint's run started with
+    (checkpoints written before settings were recorded are not checked)."""
+    before = state.get("settings")
+    if not isinstance(before, dict):
+        return
+    differ = sorted(k for k in settings if k in before and before[k] != settings[k])
+    if "config" in differ:
+        old, new = before["config"], settings["config"]
+        keys = sorted(k for k in new.keys() | old.keys() if old.get(k) != new.get(k))
+        differ = [k for k in differ if k != "config"] + [f"--set {k}" for k in keys]
+    if differ:
+        raise InputError(
+            f"resume: {ckpt} was started with other settings ({', '.join(differ)}); rerun with "
+            f"the same options, another --name / --run-dir, or delete the checkpoint to start over"
+        )
+
+
 def train(
     env: str,
     config: GraphDistNetConfig | None = None,
@@ -324,6 +387,7 @@ def train(
     Returns:
         The card written beside the weights (config, data, training log, test metrics).
     """
+    check_options(n_train, batch, lr, epochs, patience, time_budget, device)
     if compile and config is not None and config.grad_weight > 0:
         raise InputError(
             "compile: the gradient loss (grad_weight > 0) differentiates ∂d̂/∂q, a double "
@@ -334,13 +398,15 @@ def train(
         scale=round(robot.reach, 6), origin=tuple(float(v) for v in robot.chain.joint_origins[0])
     )
     run_dir = Path(run_dir or RUNS_DIR / f"{env}-{name}")
-    run_dir.mkdir(parents=True, exist_ok=True)
     out = Path(out or WEIGHTS_DIR / f"{env}.safetensors")
     torch.manual_seed(seed)
-    full = load(split_dir(env, "train", data_root), n_train)
+    train_dir = split_dir(env, "train", data_root)
+    full = check_env(load(train_dir, n_train), env, train_dir)
+    if len(full) < 2:
+        raise InputError(f"data: {train_dir} holds {len(full)} sample; training needs ≥ 2")
     order = np.random.default_rng(seed).permutation(len(full))
     n_val = max(len(full) // 10, 1)
-    extra_sets = [load(path) for path in extra]
+    extra_sets = [check_env(load(path), env, path) for path in extra]
     train_t = tensors(concat([full.subset(order[n_val:]), *extra_sets]), config)
     val_t = tensors(full.subset(order[:n_val]), config)
     net = GraphDistNet(config).to(device)
@@ -348,11 +414,21 @@ def train(
         _load_init(net, Path(init))
     step_net = torch.compile(net, dynamic=True) if compile else net
     opt = torch.optim.Adam(net.parameters(), lr=lr)
+    run_dir.mkdir(parents=True, exist_ok=True)  # after the checks of the data
     ckpt = run_dir / "checkpoint.safetensors"
     state = {"epoch": 0, "lr": lr, "best": math.inf, "stale": 0, "plateau": 0, "log": []}
     state["best_state"] = None
+    state["settings"] = {"config": config.to_dict(), "batch": batch, "lr": lr, "seed": seed}
+    state["settings"] |= {"n_train": n_train, "extra": [str(p) for p in extra]}
     if ckpt.exists():
-        state = _load_checkpoint(ckpt, net, opt)
+        check_resume(read_card(ckpt, "resume"), json.loads(json.dumps(state["settings"])), ckpt)
+        try:
+            state = _load_checkpoint(ckpt, net, opt)
+        except RuntimeError as e:  # a checkpoint of another architecture, without settings
+            raise InputError(
+                f"resume: {ckpt} does not fit this network ({' '.join(str(e).split())[:200]}); "
+                "rerun with the run's options, or delete the checkpoint to start over"
+            ) from e
         print(f"resumed {run_dir} at epoch {state['epoch']}")
     elif init is not None:  # the starting weights compete: fine-tuning never makes them worse
         state["init_val"] = validate(net, val_t, device)
@@ -413,7 +489,8 @@ def train(
     if state["best_state"] is not None:  # None: no epoch ran and no starting weights
         net.load_state_dict(state["best_state"])
     plot_losses(state["log"], run_dir / "loss.png", f"{env}-{name}")
-    test = evaluate(net, load(split_dir(env, "test", data_root)), device=device)
+    test_dir = split_dir(env, "test", data_root)
+    test = evaluate(net, check_env(load(test_dir), env, test_dir), device=device)
     log = state["log"]
     card = {
         "model": "graphdistnet",

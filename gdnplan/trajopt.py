@@ -448,7 +448,7 @@ def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | P
                 f"collision: expected 'coal', 'graphdistnet' or a DistanceModel, "
                 f"got {type(collision).__name__}"
             )
-        return collision
+        return checked(collision, scene)
     if collision == "coal":
         return CoalModel()
     if collision != "graphdistnet":
@@ -460,7 +460,16 @@ def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | P
             f"weights: {path} does not exist; train GraphDistNet for environment "
             f"{scene.name!r} first or pass weights=<file.safetensors>"
         )
-    return load_model(path)
+    return checked(load_model(path), scene)
+
+
+def checked(model: DistanceModel, scene: Scene) -> DistanceModel:
+    """``model`` after its ``check_scene(scene)``, where it has one (learned models: InputError
+    when their weights were trained for another robot), before any solver runs it."""
+    check = getattr(model, "check_scene", None)
+    if check is not None:
+        check(scene)
+    return model
 
 
 def plan(

@@ -154,3 +154,131 @@ def test_plan_rejects_zero_threads():
     result = runner.invoke(app, ["plan", "problems/planar2_square.toml", "--threads", "0"])
     assert result.exit_code != 0
     assert "--threads" in str(result.exception) + result.output
+
+
+# ---------------------------------------------------------------- hostile invocations (issue 19)
+ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
+SQUARE = str(ROOT / "problems" / "planar2_square.toml")
+HOSTILE_FILES = {  # name -> bytes of a problem file show/plan must reject in one line
+    "top_level_start.toml": b'start = [0.0, 0.1]\n[robot]\nname = "planar2"\n',
+    "ragged.toml": b'[robot]\nname = "planar2"\n[start]\nq = [[0.0], [0.1, 0.2]]\n',
+    "short.toml": b'[robot]\nname = "planar2"\n[start]\nq = [0.0]\n',
+    "binary.toml": b"\xff\xfe\x00[robot]\n",
+    "deep.toml": b"x = " + b"[" * 5000 + b"]" * 5000 + b"\n",
+    "out_of_limits.toml": b'[robot]\nname = "planar2"\n[start]\nq = [9.0, 0.1]\n',
+    "bad_goal.toml": b'[robot]\nname = "planar2"\n[start]\nq = [0.0, 0.1]\n[goal]\nq = [1, 2, 3]\n',
+}
+HOSTILE = [
+    ["show", "d", "--seed", "-1"],
+    ["show", "d", "--q", "9,0,0,0,0,0,0"],
+    ["show", "d", "--q", "nan,0,0,0,0,0,0"],
+    ["show", "{tmp}/dir.toml"],
+    *(["show", f"{{tmp}}/{name}"] for name in HOSTILE_FILES),
+    ["plan", "{tmp}/ragged.toml"],
+    ["plan", SQUARE, "--seed", "-1"],
+    ["plan", SQUARE, "--weights", str(ROOT / "weights" / "d.safetensors")],  # planar7 weights
+    ["plan", SQUARE, "--weights", "{tmp}/empty.safetensors"],
+    ["plan", SQUARE, "--bogus"],
+    ["plan"],
+    ["fetch", "--seed", "-1"],
+    ["generate", "--env", "a", "--seed", "-1"],
+    ["generate", "--env", "a", "--n", "0"],
+    ["generate", "--env", "a", "--n", "5", "--near", "2"],
+    ["generate", "--env", "a", "--workers", "0"],
+    ["reproduce", "table2", "--first", "-5"],
+    ["reproduce", "table2", "--n", "2", "--first", "5"],
+    ["field", "--grid", "0"],
+    ["field", "--grid", "1"],
+    ["field", "--grid", "-3"],
+    ["field", "--grid", "100000"],
+    ["field", "--env", "d"],
+    ["evaluate", "--n", "0"],
+    ["evaluate", "--n-grad", "0"],
+    ["evaluate", "--env", "zz"],
+    *(
+        ["train", "--env", "a", *option]
+        for option in (
+            ["--batch", "0"],
+            ["--batch", "-5"],
+            ["--lr", "nan"],
+            ["--lr", "-1"],
+            ["--lr", "inf"],
+            ["--device", "tpu"],
+            ["--device", "cuda:7"],
+            ["--n-train", "0"],
+            ["--n-train", "1"],
+            ["--epochs", "-1"],
+            ["--epochs", "0"],
+            ["--patience", "0"],
+            ["--time-budget", "-1"],
+            ["--time-budget", "nan"],
+            ["--set", "layers"],
+            ["--set", 'layers="x"'],
+            ["--set", "hidden=-4"],
+            ["--set", "nope=1"],
+            ["--model", "clearancenet", "--time-budget", "-1"],
+        )
+    ),
+]
+
+
+@pytest.fixture
+def hostile_dir(tmp_path, monkeypatch):
+    """A working directory with the hostile inputs; outputs default into it."""
+    for name, content in HOSTILE_FILES.items():
+        (tmp_path / name).write_bytes(content)
+    (tmp_path / "dir.toml").mkdir()
+    (tmp_path / "empty.safetensors").write_bytes(b"")
+    (tmp_path / "empty.json").write_text('{"model": "graphdistnet"}')
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+@pytest.mark.parametrize("args", HOSTILE, ids=lambda a: " ".join(a)[-60:])
+def test_hostile_invocation_is_one_error_line_exit_2_and_writes_nothing(args, hostile_dir, capsys):
+    from gdnplan.cli import run
+
+    before = sorted(hostile_dir.rglob("*"))
+    args = [a.replace("{tmp}", str(hostile_dir)) for a in args]
+    with pytest.raises(SystemExit) as exit_:
+        run([*args, *(["--data", str(hostile_dir / "data")] if args[0] == "generate" else [])])
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert exit_.value.code == 2, err
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    assert "Traceback" not in err
+    assert sorted(hostile_dir.rglob("*")) == before  # nothing written
+
+
+def _cli(code: str, *args: str) -> subprocess.CompletedProcess:
+    """Run ``main()`` in a subprocess after ``code`` (e.g. a monkeypatch of a failure)."""
+    script = f"import gdnplan.cli as cli\n{code}\ncli.main()"
+    return subprocess.run([sys.executable, "-c", script, *args], capture_output=True, text=True)
+
+
+BOOM = "def boom(*a, **k):\n    raise {}\ncli.make_scene = boom"
+
+
+def test_unexpected_exception_is_one_line_exit_3_and_debug_shows_the_traceback():
+    proc = _cli(BOOM.format("ZeroDivisionError('x\\ny')"), "show", "d")
+    assert proc.returncode == 3 and "Traceback" not in proc.stderr
+    assert proc.stderr.splitlines() == [
+        "error: internal error (ZeroDivisionError: x y); rerun with --debug for the traceback"
+    ]
+    proc = _cli(BOOM.format("ZeroDivisionError('x')"), "--debug", "show", "d")
+    assert proc.returncode == 3 and "Traceback" in proc.stderr and "in boom" in proc.stderr
+    assert proc.stderr.splitlines()[-1].startswith("error: internal error (ZeroDivisionError")
+
+
+def test_interrupt_is_one_line_exit_130():
+    proc = _cli(BOOM.format("KeyboardInterrupt"), "show", "d")
+    assert proc.returncode == 130 and proc.stderr.splitlines() == ["error: interrupted"]
+
+
+def test_input_errors_stay_exit_2_and_usage_errors_are_one_line():
+    proc = _cli("", "field", "--grid", "x")
+    assert proc.returncode == 2 and len(proc.stderr.splitlines()) == 1
+    assert proc.stderr.startswith("error: Invalid value for '--grid'")
+    proc = _cli("", "--debug", "show", "zz")
+    assert proc.returncode == 2 and "Traceback" in proc.stderr
+    assert proc.stderr.splitlines()[-1].startswith("error: scene: unknown name")

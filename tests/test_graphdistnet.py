@@ -403,7 +403,10 @@ def test_correction_band_warm_start_keeps_the_loaded_estimate_in_overlap(tmp_pat
     _load_init(new, path)
     q = scene.robot.sample(3000, seed=4)
     f = gp.CoalModel().distance(scene, q)
-    d_old, d_new = old.distance(scene, q), GraphDistNetModel(new, torch.float64).distance(scene, q)
+    d_old, d_new = (
+        old.distance(scene, q),
+        GraphDistNetModel(new, dtype=torch.float64).distance(scene, q),
+    )
     overlap = f < -0.01
     np.testing.assert_allclose(d_new[overlap], d_old[overlap], atol=1e-3 * np.abs(d_old).max())
     free = f > 0.05

@@ -3,6 +3,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import torch
 
@@ -96,3 +97,148 @@ def test_every_shipped_pair_is_sealed_and_verified():
     assert len(pairs) >= 10
     for path in pairs:
         assert read_card(path)[TENSORS_HASH] == file_sha256(path), path.name
+
+
+# ---------------------------------------------------------------- hostile weights (issue 19)
+import io  # noqa: E402
+import pickle  # noqa: E402
+import shutil  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+import gdnplan as gp  # noqa: E402
+from gdnplan.errors import GdnplanError  # noqa: E402
+
+WEIGHTS = Path(__file__).resolve().parent.parent / "weights"
+
+
+def _pair(tmp_path: Path, name: str, tensors: bytes | None = None, card: str | None = None,
+          src: str = "a") -> Path:  # fmt: skip
+    """A weights pair in tmp_path: a copy of the shipped ``src`` pair with either file replaced."""
+    path = tmp_path / f"{name}.safetensors"
+    if tensors is None:
+        shutil.copy(WEIGHTS / f"{src}.safetensors", path)
+    else:
+        path.write_bytes(tensors)
+    if card is None:
+        shutil.copy(WEIGHTS / f"{src}.json", card_path(path))
+    else:
+        card_path(path).write_text(card)
+    return path
+
+
+def _torch_save() -> bytes:
+    buffer = io.BytesIO()
+    torch.save({"w": torch.zeros(3)}, buffer)
+    return buffer.getvalue()
+
+
+def _card(**changes) -> str:
+    card = json.loads((WEIGHTS / "a.json").read_text())
+    return json.dumps(card | changes)
+
+
+def _config(**changes) -> str:
+    card = json.loads((WEIGHTS / "a.json").read_text())
+    return json.dumps(card | {"config": card["config"] | changes})
+
+
+def _nan_tensors() -> bytes:
+    from safetensors.torch import load_file, save
+
+    tensors = load_file(WEIGHTS / "a.safetensors")
+    return save({k: torch.full_like(v, float("nan")) for k, v in tensors.items()})
+
+
+HOSTILE_WEIGHTS = {
+    "truncated": lambda: {"tensors": (WEIGHTS / "a.safetensors").read_bytes()[:5000]},
+    "header_only": lambda: {"tensors": (WEIGHTS / "a.safetensors").read_bytes()[:8]},
+    "empty": lambda: {"tensors": b""},
+    "pickle": lambda: {"tensors": pickle.dumps({"w": [1.0]})},
+    "torch_save": lambda: {"tensors": _torch_save()},
+    "all_nan": lambda: {"tensors": _nan_tensors()},
+    "card_malformed": lambda: {"card": "{not json"},
+    "card_list": lambda: {"card": "[1, 2]"},
+    "card_not_utf8": lambda: {"card": "\udcff"},
+    "card_no_config": lambda: {"card": json.dumps({"model": "graphdistnet"})},
+    "card_config_list": lambda: {"card": _card(config=[1, 2])},
+    "card_unknown_model": lambda: {"card": _card(model="svm")},
+    "card_of_clearancenet": lambda: {"card": (WEIGHTS / "clearancenet_a.json").read_text()},
+    "tensors_of_clearancenet": lambda: {
+        "tensors": (WEIGHTS / "clearancenet_a.safetensors").read_bytes()
+    },
+    "wrong_shapes": lambda: {"card": _config(hidden=64)},
+    "huge_layers": lambda: {"card": _config(layers=10**9)},
+    "huge_hidden": lambda: {"card": _config(hidden=10**12)},
+    "bad_tau": lambda: {"card": _config(tau=-1.0)},
+    "nan_scale": lambda: {"card": _config(scale=float("nan"))},
+    "mlp_int": lambda: {"card": _config(mlp=5)},
+}
+
+
+@pytest.mark.parametrize("name", HOSTILE_WEIGHTS)
+def test_hostile_weights_files_are_gdnplan_errors_naming_the_file(name, tmp_path):
+    parts = HOSTILE_WEIGHTS[name]()
+    if parts.get("card") == "\udcff":
+        path = _pair(tmp_path, name)
+        card_path(path).write_bytes(b"\xff\xfe{")
+    else:
+        path = _pair(tmp_path, name, **parts)
+    with pytest.raises(GdnplanError, match=name):
+        gp.load_model(path)
+
+
+def test_weights_for_another_robot_raise_before_use():
+    """(a)'s planar2 weights on a planar7 scene and (d)'s on a planar2 one; ClearanceNet of the
+    fixed layout (a) on a (b) scene. Same robot, other layout: GraphDistNet is used (its obstacle
+    graph is an input; models/checks.py has the measurements)."""
+    for weights, scene in (
+        ("a", "d"),
+        ("d", "a"),
+        ("clearancenet_a", "b"),
+        ("clearancenet_d", "a"),
+    ):
+        model = gp.load_model(WEIGHTS / f"{weights}.safetensors")
+        s = gp.make_scene(scene, seed=1)
+        with pytest.raises(GdnplanError, match="weights"):
+            model.distance(s, s.robot.sample(2, seed=0))
+    model, s = gp.load_model(WEIGHTS / "a.safetensors"), gp.make_scene("b", seed=1)
+    assert np.isfinite(model.distance(s, s.robot.sample(2, seed=0))).all()
+
+
+JSON = st.recursive(
+    st.none() | st.booleans() | st.integers(-(10**12), 10**12) | st.floats() | st.text(max_size=5),
+    lambda children: (
+        st.lists(children, max_size=3) | st.dictionaries(st.text(max_size=5), children, max_size=3)
+    ),
+    max_leaves=6,
+)
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    where=st.sampled_from(["card", "config"]),
+    key=st.sampled_from(["model", "config", "robot", "env", "layers", "hidden", "mlp", "readout",
+                         "activation", "cross", "cross_k", "tau", "scale", "origin", "max_edge",
+                         "min_readout", "node_distance", "probe_split", "correction_band"]),
+    value=JSON,
+)  # fmt: skip
+def test_mutated_cards_load_or_raise_gdnplan_errors(where, key, value, tmp_path):
+    """Any one field of a card (or of its config) replaced by any JSON value: the weights load
+    or a GdnplanError says why (never another exception; sizes are checked on the meta device,
+    so a huge network costs nothing). Inference is not run: run-time sizes such as cross_k and
+    probe_split are not bounded by the card check."""
+    card = json.loads((WEIGHTS / "a.json").read_text())
+    if where == "card":
+        card[key] = value
+    elif isinstance(card.get("config"), dict):
+        card["config"][key] = value
+    path = _pair(tmp_path, "mutated", card=json.dumps(card))
+    try:
+        gp.load_model(path)
+    except GdnplanError:
+        pass

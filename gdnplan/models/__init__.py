@@ -55,7 +55,7 @@ def load_model(path: Path | str) -> DistanceModel:
 
     The card's ``"model"`` field selects the class (``"graphdistnet"``, ``"clearancenet"``).
     """
-    kind = read_card(path, "model").get("model")
+    kind = read_card(path).get("model")
     if kind == "graphdistnet":
         from .graphdistnet import load_graphdistnet
 

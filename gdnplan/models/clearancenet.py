@@ -37,6 +37,7 @@ from torch import nn
 from ..data import Dataset, pad_polygons
 from ..errors import InputError
 from ..scene import Scene, make_scene
+from .checks import build_net, card_config, check_count, check_fits, check_layout
 from .weights import card_path, read_weights, write_weights
 
 POSE_ENVS = ("a", "b", "c", "d")
@@ -82,6 +83,23 @@ class ClearanceNetConfig:
             scale=round(scene.robot.reach, 6),
         )
         return ClearanceNetConfig(**{**asdict(base), **changes})
+
+    @classmethod
+    def from_dict(cls, data: dict) -> ClearanceNetConfig:
+        """The config of a card (``hidden`` a list there); InputError on bad fields."""
+        config = cls(**{**data, "hidden": tuple(data.get("hidden", cls.hidden))})
+        ints = (config.dof, config.n_obstacles, config.n_vertices, *config.hidden)
+        if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 1 for v in ints):
+            raise InputError(
+                "ClearanceNet config: dof, n_obstacles, n_vertices, hidden must be ≥ 1"
+            )
+        if config.encoding not in ("pose", "vertices") or not isinstance(config.env, str):
+            raise InputError(f"ClearanceNet config: unknown encoding {config.encoding!r}")
+        if not (isinstance(config.dropout, (int, float)) and 0 <= config.dropout < 1):
+            raise InputError(f"ClearanceNet config: dropout in [0, 1), got {config.dropout!r}")
+        if not (isinstance(config.scale, (int, float)) and 0 < config.scale < math.inf):
+            raise InputError(f"ClearanceNet config: scale must be positive, got {config.scale!r}")
+        return config
 
     @property
     def n_features(self) -> int:
@@ -171,8 +189,20 @@ class ClearanceNetModel:
         return np.concatenate(ds), (np.concatenate(gs) if grad else None)
 
     def _scene_vector(self, scene: Scene, b: int) -> np.ndarray:
+        self.check_scene(scene)
         polys, sizes = pad_polygons([list(scene.obstacles)])
         return np.repeat(obstacle_vector(self.net.config, polys, sizes), b, 0)
+
+    def check_scene(self, scene: Scene) -> None:
+        """InputError unless the weights fit ``scene``'s robot and obstacles (models/checks.py)."""
+        config = self.net.config
+        check_fits(self.card, scene, config.dof)
+        check_layout(self.card, scene, lambda: make_scene(config.env))
+        if config.encoding == "pose" and any(len(p) != 4 for p in scene.obstacles):
+            raise InputError(
+                f"obstacles: ClearanceNet of env {config.env} encodes squares by their pose; "
+                "this scene has other polygons (use GraphDistNet or coal)"
+            )
 
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
         q = scene.robot.check_q(q)
@@ -194,13 +224,13 @@ class ClearanceNetModel:
 
 def load(path: Path | str) -> ClearanceNetModel:
     """A :class:`ClearanceNetModel` from ``path`` (.safetensors) and its JSON card."""
+    path = Path(path)
     tensors, card = read_weights(path)
     if card.get("model") != "clearancenet":
         raise InputError(f"weights: {card_path(path)} is not a ClearanceNet card")
-    cfg = card["config"]
-    config = ClearanceNetConfig(**{**cfg, "hidden": tuple(cfg["hidden"])})
-    net = ClearanceNet(config)
-    net.load_state_dict(tensors)
+    config = card_config(path, card, "ClearanceNet", ClearanceNetConfig.from_dict)
+    check_count(len(config.hidden) or 1, len(tensors), "hidden", path)
+    net = build_net(path, "ClearanceNet", lambda: ClearanceNet(config), tensors)
     return ClearanceNetModel(net, card)
 
 

@@ -77,6 +77,7 @@ from torch import nn
 from ..errors import InputError
 from ..graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
 from ..scene import Scene
+from .checks import build_net, card_config, check_count, check_fits
 from .weights import read_weights
 
 PAD_DIST2 = 1e6  # squared distance (normalised units²) given to padded candidates
@@ -151,6 +152,10 @@ class GraphDistNetConfig:
     origin: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if any(isinstance(v, float) and not math.isfinite(v) for v in np.ravel(value)):
+                raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
         if self.activation not in ("leaky_relu", "silu"):
             raise InputError(
                 f"activation: expected 'leaky_relu' or 'silu', got {self.activation!r}"
@@ -934,10 +939,15 @@ class GraphDistNetModel:
         self.device = torch.device(device)
         self._scenes: weakref.WeakKeyDictionary[Scene, _SceneCache] = weakref.WeakKeyDictionary()
 
+    def check_scene(self, scene: Scene) -> None:
+        """InputError unless the weights were trained for ``scene``'s robot (models/checks.py)."""
+        check_fits(self.card, scene)
+
     def _graphs(self, scene: Scene) -> _SceneCache:
         """The (cached) robot graph, obstacle graph and lean scene graph of ``scene``."""
         cached = self._scenes.get(scene)
         if cached is None:
+            self.check_scene(scene)
             graph = robot_graph(scene.robot, self.config.max_edge)
             polys, sizes = scene_obstacles([scene])
             obstacles = obstacle_graph(
@@ -1063,7 +1073,11 @@ def _repeat(graph: GraphBatch, b: int) -> GraphBatch:
 
 def load_graphdistnet(path: Path | str) -> GraphDistNetModel:
     """A :class:`GraphDistNetModel` from ``path`` (safetensors) and the JSON card beside it."""
+    path = Path(path)
     tensors, card = read_weights(path)
-    net = GraphDistNet(GraphDistNetConfig.from_dict(card["config"]))
-    net.load_state_dict(tensors)
+    config = card_config(path, card, "GraphDistNet", GraphDistNetConfig.from_dict)
+    for name, value in (("layers", config.layers), ("mlp", len(config.mlp) or 1)):
+        check_count(value, len(tensors), name, path)  # else a huge network before the check
+    check_count(len(config.readout) or 1, len(tensors), "readout", path)
+    net = build_net(path, "GraphDistNet", lambda: GraphDistNet(config), tensors)
     return GraphDistNetModel(net, card)

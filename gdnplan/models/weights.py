@@ -25,10 +25,11 @@ import sys
 from pathlib import Path
 
 import torch
-from safetensors.torch import load_file, save_file
+from safetensors.torch import save_file
 
 from ..errors import InputError
 from ..files import atomic_path, write_text
+from .checks import load_tensors, parse_card
 
 TENSORS_HASH = "tensors_sha256"
 
@@ -78,7 +79,7 @@ def read_card(path: Path | str, what: str = "weights") -> dict:
     card = card_path(path)
     if not card.exists():
         raise InputError(f"{what}: no card {card.name} beside {path}")
-    content = json.loads(card.read_text())
+    content = parse_card(card, what)
     check_pair(path, content, what)
     return content
 
@@ -90,7 +91,7 @@ def read_weights(path: Path | str, what: str = "weights") -> tuple[dict[str, tor
     if not path.exists():
         raise InputError(f"{what}: {path} not found")
     card = read_card(path, what)
-    return load_file(str(path)), card
+    return load_tensors(path, what), card
 
 
 def write_json(path: Path | str, obj: dict) -> None:
