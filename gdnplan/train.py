@@ -46,7 +46,7 @@ from .evaluate import roc_auc, sha256_prefix, used_cosine_distances
 from .files import atomic_path
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
-from .models.weights import read_weights, write_weights
+from .models.weights import read_card, read_weights, write_weights
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS_DIR = ROOT / "weights"
