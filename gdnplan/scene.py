@@ -26,8 +26,24 @@ import numpy as np
 from shapely.geometry import Point, Polygon
 
 from .errors import InputError, ProblemFileError, UnknownNameError
-from .geometry import alpha_shape, as_polygon, convex_decomposition, limit_vertices, square
+from .geometry import (
+    alpha_shape,
+    as_polygon,
+    check_part,
+    convex_decomposition,
+    limit_vertices,
+    square,
+)
 from .robot import Robot, load_robot
+
+MAX_OBSTACLES = 1000  # obstacle polygons of one scene
+MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
+
+
+def coordinate_bound(robot: Robot) -> float:
+    """Largest |x|, |y| offset (m) of an obstacle vertex from joint 1: max(100 m, 100 × reach).
+    Farther obstacles can never touch the arm, and huge coordinates (1e300) crashed coal."""
+    return max(100.0, 100.0 * robot.reach)
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +52,10 @@ class Scene:
 
     Attributes:
         robot: the robot (with its current gripper state, where it has one).
-        obstacles: simple CCW polygons (m, 2); non-convex ones are split for coal.
+        obstacles: simple CCW polygons (m, 2); non-convex ones are split for coal. Checked:
+            at most ``MAX_OBSTACLES`` polygons of ``geometry.MAX_VERTICES`` vertices,
+            finite, within :func:`coordinate_bound` of joint 1, no repeated vertices, every
+            convex part at least ``geometry.MIN_THICKNESS`` thick (:func:`check_part`).
         name: generator name or ``"custom"``.
         seed: generator seed, when generated.
         info: generator metadata (e.g. the fetch scene's storage and stick).
@@ -49,8 +68,28 @@ class Scene:
     info: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if len(self.obstacles) > MAX_OBSTACLES:
+            raise InputError(
+                f"obstacles: {len(self.obstacles)} polygons, the limit is {MAX_OBSTACLES}"
+            )
         checked = tuple(as_polygon(p, f"obstacles[{i}]") for i, p in enumerate(self.obstacles))
         object.__setattr__(self, "obstacles", checked)
+        bound = coordinate_bound(self.robot)
+        base = self.robot.chain.joint_origins[0]
+        for i, poly in enumerate(checked):
+            far = float(np.max(np.abs(poly - base)))
+            if far > bound:
+                raise InputError(
+                    f"obstacles[{i}]: a vertex is {far:.3g} m from the robot's base, the limit "
+                    f"is {bound:.3g} m (max(100 m, 100 × reach)); remove or move the obstacle"
+                )
+            for part in convex_decomposition(poly):
+                check_part(part, f"obstacles[{i}]")
+        if len(self.obstacle_parts) > MAX_PARTS:
+            raise InputError(
+                f"obstacles: {len(self.obstacle_parts)} convex parts, the limit is {MAX_PARTS}; "
+                "use fewer or simpler (less non-convex) obstacles"
+            )
 
     @cached_property
     def obstacle_parts(self) -> tuple[np.ndarray, ...]:
