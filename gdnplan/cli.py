@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import json
 import sys
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import typer
 
-from .errors import GdnplanError, InputError, ProblemFileError
+from .errors import GdnplanError, InputError
 from .scene import Scene, make_scene, scene_from_config
 
 app = typer.Typer(
@@ -47,21 +46,20 @@ def parse_vector(text: str, name: str) -> np.ndarray:
 
 
 def read_toml(path: Path) -> dict:
-    """Parse a TOML file; raises ProblemFileError with the parser's line and column."""
-    if not path.exists():
-        raise ProblemFileError(f"{path}: no such file")
-    try:
-        return tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise ProblemFileError(f"{path}: malformed TOML ({e})") from e
+    """Parse a TOML file; raises ProblemFileError (unreadable, not UTF-8, malformed, too deep)."""
+    from .trajopt import read_problem_file
+
+    return read_problem_file(path)
 
 
 def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
     """A scene from a problem TOML file (with its start q) or from a generator name."""
     if target.endswith(".toml"):
+        from .trajopt import problem_start
+
         cfg = read_toml(Path(target))
-        start = cfg.get("start", {}).get("q")
-        return scene_from_config(cfg), None if start is None else np.asarray(start, float)
+        scene = scene_from_config(cfg)
+        return scene, problem_start(cfg, scene)
     return make_scene(target, seed=seed), None
 
 

@@ -130,7 +130,9 @@ def scene_names() -> list[str]:
 
 
 def make_scene(name: str, seed: int = 0, **options) -> Scene:
-    """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed."""
+    """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
     if name not in _GENERATORS:
         raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
     return _GENERATORS[name](seed=seed, **options)
@@ -239,15 +241,20 @@ def scene_from_config(cfg: dict) -> Scene:
     base = None
     if "generator" in scene_cfg:
         seed = scene_cfg.get("seed", 0)
-        if not isinstance(seed, int):
-            raise ProblemFileError(f"[scene] seed: expected an integer, got {seed!r}")
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise ProblemFileError(f"[scene] seed: expected an integer ≥ 0, got {seed!r}")
+        generator = scene_cfg["generator"]
+        if not isinstance(generator, str):
+            raise ProblemFileError(f"[scene] generator: expected a name, got {generator!r}")
         options = {k: v for k, v in scene_cfg.items() if k not in ("generator", "seed")}
-        base = make_scene(scene_cfg["generator"], seed=seed, **options)
+        base = _call("[scene]", make_scene, generator, seed=seed, **options)
         obstacles += list(base.obstacles)
         name, info = base.name, dict(base.info)
     if "name" in robot_cfg:
         options = {k: v for k, v in robot_cfg.items() if k != "name"}
-        robot = load_robot(robot_cfg["name"], **options)
+        if not isinstance(robot_cfg["name"], str):
+            raise ProblemFileError(f"[robot] name: expected a name, got {robot_cfg['name']!r}")
+        robot = _call("[robot]", load_robot, robot_cfg["name"], **options)
     elif base is not None:
         robot = base.robot
     else:
@@ -258,8 +265,22 @@ def scene_from_config(cfg: dict) -> Scene:
     for i, item in enumerate(extra):
         if not isinstance(item, dict) or "polygon" not in item:
             raise ProblemFileError(f"[[obstacles]] #{i}: missing 'polygon = [[x, y], ...]'")
+        if set(item) != {"polygon"}:
+            unknown = sorted(set(item) - {"polygon"})
+            raise ProblemFileError(f"[[obstacles]] #{i}: unknown key(s) {unknown}; only polygon")
         try:
             obstacles.append(as_polygon(item["polygon"], f"obstacles[{i}].polygon"))
         except InputError as e:
             raise ProblemFileError(str(e)) from e
-    return Scene(robot, tuple(obstacles), name=name, seed=seed, info=info)
+    return _call("[[obstacles]]", Scene, robot, tuple(obstacles), name=name, seed=seed, info=info)
+
+
+def _call(where: str, factory: Callable, *args, **options):
+    """factory(*args, **options), with an unsupported option or a bad value (TypeError,
+    InputError) reported as a ProblemFileError naming the table."""
+    try:
+        return factory(*args, **options)
+    except UnknownNameError:
+        raise
+    except (TypeError, InputError) as e:
+        raise ProblemFileError(f"{where}: {e}") from e
