@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import sys
-import tomllib
 import traceback
 from pathlib import Path
 
@@ -68,22 +67,10 @@ def parse_vector(text: str, name: str) -> np.ndarray:
 
 
 def read_toml(path: Path) -> dict:
-    """Parse a TOML file; ProblemFileError when it is unreadable, not UTF-8 or malformed (with
-    the parser's line and column)."""
-    if not path.exists():
-        raise ProblemFileError(f"{path}: no such file")
-    try:
-        return tomllib.loads(path.read_bytes().decode("utf-8"))
-    except OSError as e:
-        raise ProblemFileError(f"{path}: cannot read the problem file ({e.strerror})") from e
-    except UnicodeDecodeError as e:
-        raise ProblemFileError(
-            f"{path}: not a UTF-8 text file ({e.reason} at byte {e.start})"
-        ) from e
-    except RecursionError as e:
-        raise ProblemFileError(f"{path}: malformed TOML (nested too deeply)") from e
-    except tomllib.TOMLDecodeError as e:
-        raise ProblemFileError(f"{path}: malformed TOML ({e})") from e
+    """Parse a TOML file; raises ProblemFileError (unreadable, not UTF-8, malformed, too deep)."""
+    from .trajopt import read_problem_file
+
+    return read_problem_file(path)
 
 
 def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:

@@ -20,16 +20,19 @@ def signed_area(poly: np.ndarray) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
+MAX_VERTICES = 2000  # vertices of one polygon
+MIN_THICKNESS = 1e-6  # m: floor of the width of every convex part (and of every edge length)
+REL_THICKNESS = 1e-6  # ... relative to the part's extent (coal's hull crashed below ~5e-9)
+
+
 def as_polygon(vertices, name: str = "polygon") -> np.ndarray:
     """Validate vertices and return them as a CCW (m, 2) float64 polygon.
 
-    Raises InputError naming ``name`` for a wrong shape, NaN, fewer than 3 distinct vertices,
-    zero area or self-intersection.
+    Raises InputError naming ``name`` for a wrong shape, NaN or infinite coordinates, fewer
+    than 3 or more than ``MAX_VERTICES`` vertices, repeated vertices (edges shorter than
+    ``MIN_THICKNESS``), zero area or self-intersection. Booleans and strings are no numbers.
     """
-    try:
-        poly = np.array(vertices, dtype=float)
-    except (TypeError, ValueError) as e:
-        raise InputError(f"{name}: expected a list of [x, y] vertices") from e
+    poly = _float_array(vertices, name)
     if poly.ndim != 2 or poly.shape[1] != 2:
         raise InputError(f"{name}: expected vertices of shape (m, 2), got {poly.shape}")
     if not np.all(np.isfinite(poly)):
@@ -38,12 +41,67 @@ def as_polygon(vertices, name: str = "polygon") -> np.ndarray:
         poly = poly[:-1]
     if len(poly) < 3:
         raise InputError(f"{name}: needs at least 3 vertices, got {len(poly)}")
+    if len(poly) > MAX_VERTICES:
+        raise InputError(
+            f"{name}: {len(poly)} vertices, the limit is {MAX_VERTICES}; simplify the polygon"
+        )
+    if np.max(np.abs(poly)) > 1e12:
+        raise InputError(f"{name}: coordinates beyond 1e12 m; use metres near the robot")
+    edges = np.linalg.norm(np.roll(poly, -1, 0) - poly, axis=1)
+    if np.min(edges) < MIN_THICKNESS:
+        k = int(np.argmin(edges))
+        raise InputError(
+            f"{name}: vertices {k} and {(k + 1) % len(poly)} are repeated or closer than "
+            f"{MIN_THICKNESS} m; remove one"
+        )
     if not Polygon(poly).is_valid:
         raise InputError(f"{name}: the polygon intersects itself; list its vertices in order")
     area = signed_area(poly)
     if abs(area) < 1e-12:
         raise InputError(f"{name}: the polygon has zero area")
     return poly if area > 0 else poly[::-1].copy()
+
+
+def _float_array(vertices, name: str) -> np.ndarray:
+    """Nested numbers -> float array; booleans, strings and other objects are rejected."""
+    if isinstance(vertices, np.ndarray):
+        if vertices.dtype.kind not in "iuf":
+            raise InputError(f"{name}: expected numbers, got an array of {vertices.dtype}")
+        return np.array(vertices, dtype=float)
+    if not isinstance(vertices, (list, tuple)) or not all(
+        isinstance(v, (list, tuple, np.ndarray)) for v in vertices
+    ):
+        raise InputError(f"{name}: expected a list of [x, y] vertices")
+    for v in vertices:
+        for x in v:
+            if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
+                raise InputError(f"{name}: expected numbers as coordinates, got {x!r}")
+    try:
+        return np.array(vertices, dtype=float)
+    except (TypeError, ValueError, OverflowError) as e:
+        raise InputError(f"{name}: expected a list of [x, y] vertices") from e
+
+
+def min_width(poly: np.ndarray) -> float:
+    """Width (m) of a convex polygon: the smallest extent over its edge normals."""
+    edges = np.roll(poly, -1, 0) - poly
+    normals = np.c_[-edges[:, 1], edges[:, 0]] / np.linalg.norm(edges, axis=1)[:, None]
+    extent = (poly - poly.mean(0)) @ normals.T  # (m vertices, m normals)
+    return float(np.min(extent.max(0) - extent.min(0)))
+
+
+def check_part(part: np.ndarray, name: str, floor: float | None = None) -> None:
+    """InputError unless the convex part is at least ``floor`` thick (default
+    max(MIN_THICKNESS, REL_THICKNESS · max(extent, 2 m))): thinner slivers crash coal's
+    convex hull (a 0.3 m × 1e-8 m rectangle segfaulted)."""
+    size = float(np.max(np.ptp(part, axis=0)))
+    floor = max(MIN_THICKNESS, REL_THICKNESS * max(size, 2.0)) if floor is None else floor
+    width = min_width(part)
+    if width < floor:
+        raise InputError(
+            f"{name}: a convex part is only {width:.3g} m thick, the floor is {floor:.3g} m; "
+            "make the obstacle thicker or remove it"
+        )
 
 
 def is_convex(poly: np.ndarray, tol: float = 1e-12) -> bool:
@@ -127,43 +185,66 @@ def limit_vertices(poly: np.ndarray, max_vertices: int) -> np.ndarray:
 
 
 def convex_decomposition(poly: np.ndarray) -> list[np.ndarray]:
-    """Split a simple polygon into convex CCW parts whose union is the polygon.
+    """Split a simple CCW polygon into convex CCW parts whose union is the polygon.
 
-    Constrained Delaunay triangulation (shapely), then Hertel–Mehlhorn: merge neighbouring
-    pieces across a shared edge whenever the union stays convex. A convex input is returned as
-    the only part.
+    Constrained Delaunay triangulation (shapely, O(n log n)), then Hertel–Mehlhorn: drop
+    each diagonal whose removal keeps both its ends convex (O(1) per diagonal on a half-edge
+    structure), at most 4× the fewest convex parts. A convex input is its only part.
+    2 000 vertices take well under a second.
     """
     if is_convex(poly):
         return [poly]
+    index = {tuple(p): i for i, p in enumerate(poly.tolist())}
     tris = shapely.constrained_delaunay_triangles(Polygon(poly))
-    pieces = [as_polygon(np.asarray(t.exterior.coords)[:-1]) for t in tris.geoms]
-    merged = True
-    while merged:
-        merged = False
-        for i in range(len(pieces)):
-            for j in range(i + 1, len(pieces)):
-                joined = _merge_convex(pieces[i], pieces[j])
-                if joined is not None:
-                    pieces[i] = joined
-                    del pieces[j]
-                    merged = True
-                    break
-            if merged:
-                break
-    return pieces
+    succ: dict[tuple[int, int], int] = {}  # half-edge (u, v) -> w: the next one is (v, w)
+    pred: dict[tuple[int, int], int] = {}  # half-edge (u, v) -> t: the previous one is (t, u)
+    for t in tris.geoms:
+        ring = [index[tuple(c)] for c in np.asarray(t.exterior.coords)[:-1].tolist()]
+        if signed_area(poly[ring]) < 0:
+            ring = ring[::-1]
+        for k in range(3):
+            a, b, c = ring[k], ring[(k + 1) % 3], ring[(k + 2) % 3]
+            succ[(a, b)], pred[(b, c)] = c, a
+    for a, b in [e for e in succ if e[0] < e[1] and (e[1], e[0]) in succ]:
+        p, q = pred[(a, b)], succ[(b, a)]  # around a: (p, a) then (a, q)
+        r, s = pred[(b, a)], succ[(a, b)]  # around b: (r, b) then (b, s)
+        if _left(poly[p], poly[a], poly[q]) and _left(poly[r], poly[b], poly[s]):
+            for e in ((a, b), (b, a)):
+                del succ[e], pred[e]
+            succ[(p, a)], pred[(a, q)] = q, p
+            succ[(r, b)], pred[(b, s)] = s, r
+    return [_drop_collinear(poly[ring]) for ring in _cycles(succ)]
 
 
-def _merge_convex(p: np.ndarray, r: np.ndarray) -> np.ndarray | None:
-    """Union of two convex polygons sharing an edge, if it is convex; else None."""
-    union = Polygon(p).union(Polygon(r))
-    if not isinstance(union, Polygon) or union.area < Polygon(p).area + Polygon(r).area - 1e-12:
-        return None
-    shared = Polygon(p).intersection(Polygon(r))
-    if shared.length < 1e-9:  # touching at a point only
-        return None
-    ring = np.asarray(union.simplify(0.0).exterior.coords)[:-1]
-    ring = ring if signed_area(ring) > 0 else ring[::-1]
-    return ring if is_convex(ring, tol=1e-10) else None
+def _left(p: np.ndarray, a: np.ndarray, q: np.ndarray) -> bool:
+    """p -> a -> q turns left or goes straight (relative tolerance 1e-12)."""
+    u, v = a - p, q - a
+    return u[0] * v[1] - u[1] * v[0] >= -1e-12 * np.linalg.norm(u) * np.linalg.norm(v)
+
+
+def _cycles(succ: dict[tuple[int, int], int]) -> list[list[int]]:
+    """The vertex cycles of the half-edge structure (one per part)."""
+    seen: set[tuple[int, int]] = set()
+    out = []
+    for start in succ:
+        if start in seen:
+            continue
+        ring, e = [], start
+        while e not in seen:
+            seen.add(e)
+            ring.append(e[0])
+            e = (e[1], succ[e])
+        out.append(ring)
+    return out
+
+
+def _drop_collinear(part: np.ndarray) -> np.ndarray:
+    """Remove vertices where a convex part goes straight on."""
+    prev, nxt = np.roll(part, 1, 0), np.roll(part, -1, 0)
+    u, v = part - prev, nxt - part
+    cross = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    keep = np.abs(cross) > 1e-12 * np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1)
+    return part[keep] if keep.sum() >= 3 else part
 
 
 def polygon_distance(a: np.ndarray, b: np.ndarray) -> float:

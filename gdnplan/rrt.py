@@ -7,12 +7,14 @@ motion, not only at its vertices.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from .ccd import certify_path, motion_bound
+from .errors import InputError
 from .scene import Scene
 
 
@@ -79,13 +81,18 @@ def rrt_connect(
     """Bidirectional RRT-Connect (Kuffner & LaValle 2000) between start and goal (dof,).
 
     ``step`` is the largest joint-space (2-norm, rad) extension; samples are uniform within
-    the joint limits; every edge is certified at ``clearance`` (m).
+    the joint limits; every edge is certified at ``clearance`` (m). Both the outer loop and
+    the greedy connect loop stop at ``time_limit`` (s) or ``max_iterations`` extensions.
+    Raises InputError for a step, time limit or clearance that is not a finite number > 0
+    (clearance ≥ 0), or ``max_iterations`` < 1.
     """
+    _check_settings(step, time_limit, clearance, max_iterations)
     robot = scene.robot
     lower = robot.lower if lower is None else lower
     upper = robot.upper if upper is None else upper
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
+    deadline = t0 + time_limit
     if edge_free(scene, start, goal, clearance):
         return RRTResult(True, np.stack([start, goal]), 0, time.perf_counter() - t0)
     trees = [_Tree(start), _Tree(goal)]
@@ -99,7 +106,7 @@ def rrt_connect(
         if not edge_free(scene, a.q[i], q_new, clearance):
             continue
         i_new = a.add(q_new, i)
-        j = _connect(scene, b, q_new, step, clearance)
+        j = _connect(scene, b, q_new, step, clearance, deadline)
         if j is not None:
             path_a, path_b = a.branch(i_new), b.branch(j)[::-1]
             path = np.vstack([path_a, path_b])
@@ -108,16 +115,38 @@ def rrt_connect(
     return RRTResult(False, np.zeros((0, robot.dof)), it, time.perf_counter() - t0)
 
 
-def _connect(scene: Scene, tree: _Tree, target: np.ndarray, step: float, clearance: float):
-    """Extend ``tree`` greedily towards target; the index of the node reaching it, else None."""
+def _check_settings(step, time_limit, clearance, max_iterations) -> None:
+    for name, value in (("rrt_step", step), ("rrt_time", time_limit)):
+        if not _number(value) or not math.isfinite(value) or value <= 0:
+            raise InputError(f"{name}: expected a finite number > 0, got {value!r}")
+    if not _number(clearance) or not math.isfinite(clearance) or clearance < 0:
+        raise InputError(f"rrt clearance: expected a finite number ≥ 0, got {clearance!r}")
+    if (
+        isinstance(max_iterations, bool)
+        or not isinstance(max_iterations, int)
+        or max_iterations < 1
+    ):
+        raise InputError(f"max_iterations: expected an integer ≥ 1, got {max_iterations!r}")
+
+
+def _number(value) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+
+
+def _connect(
+    scene: Scene, tree: _Tree, target: np.ndarray, step: float, clearance: float, deadline: float
+):
+    """Extend ``tree`` greedily towards target; the index of the node reaching it, else None
+    (also when the clock passes ``deadline``)."""
     i = tree.nearest(target)
-    while True:
+    while time.perf_counter() <= deadline:
         q_new = _steer(tree.q[i], target, step)
         if not edge_free(scene, tree.q[i], q_new, clearance):
             return None
         i = tree.add(q_new, i)
         if np.array_equal(q_new, target):
             return i
+    return None
 
 
 def shortcut(

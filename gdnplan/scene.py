@@ -26,8 +26,24 @@ import numpy as np
 from shapely.geometry import Point, Polygon
 
 from .errors import InputError, ProblemFileError, UnknownNameError
-from .geometry import alpha_shape, as_polygon, convex_decomposition, limit_vertices, square
+from .geometry import (
+    alpha_shape,
+    as_polygon,
+    check_part,
+    convex_decomposition,
+    limit_vertices,
+    square,
+)
 from .robot import Robot, load_robot
+
+MAX_OBSTACLES = 1000  # obstacle polygons of one scene
+MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
+
+
+def coordinate_bound(robot: Robot) -> float:
+    """Largest |x|, |y| offset (m) of an obstacle vertex from joint 1: max(100 m, 100 × reach).
+    Farther obstacles can never touch the arm, and huge coordinates (1e300) crashed coal."""
+    return max(100.0, 100.0 * robot.reach)
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +52,10 @@ class Scene:
 
     Attributes:
         robot: the robot (with its current gripper state, where it has one).
-        obstacles: simple CCW polygons (m, 2); non-convex ones are split for coal.
+        obstacles: simple CCW polygons (m, 2); non-convex ones are split for coal. Checked:
+            at most ``MAX_OBSTACLES`` polygons of ``geometry.MAX_VERTICES`` vertices,
+            finite, within :func:`coordinate_bound` of joint 1, no repeated vertices, every
+            convex part at least ``geometry.MIN_THICKNESS`` thick (:func:`check_part`).
         name: generator name or ``"custom"``.
         seed: generator seed, when generated.
         info: generator metadata (e.g. the fetch scene's storage and stick).
@@ -49,8 +68,28 @@ class Scene:
     info: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if len(self.obstacles) > MAX_OBSTACLES:
+            raise InputError(
+                f"obstacles: {len(self.obstacles)} polygons, the limit is {MAX_OBSTACLES}"
+            )
         checked = tuple(as_polygon(p, f"obstacles[{i}]") for i, p in enumerate(self.obstacles))
         object.__setattr__(self, "obstacles", checked)
+        bound = coordinate_bound(self.robot)
+        base = self.robot.chain.joint_origins[0]
+        for i, poly in enumerate(checked):
+            far = float(np.max(np.abs(poly - base)))
+            if far > bound:
+                raise InputError(
+                    f"obstacles[{i}]: a vertex is {far:.3g} m from the robot's base, the limit "
+                    f"is {bound:.3g} m (max(100 m, 100 × reach)); remove or move the obstacle"
+                )
+            for part in convex_decomposition(poly):
+                check_part(part, f"obstacles[{i}]")
+        if len(self.obstacle_parts) > MAX_PARTS:
+            raise InputError(
+                f"obstacles: {len(self.obstacle_parts)} convex parts, the limit is {MAX_PARTS}; "
+                "use fewer or simpler (less non-convex) obstacles"
+            )
 
     @cached_property
     def obstacle_parts(self) -> tuple[np.ndarray, ...]:
@@ -91,7 +130,9 @@ def scene_names() -> list[str]:
 
 
 def make_scene(name: str, seed: int = 0, **options) -> Scene:
-    """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed."""
+    """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
     if name not in _GENERATORS:
         raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
     return _GENERATORS[name](seed=seed, **options)
@@ -200,15 +241,20 @@ def scene_from_config(cfg: dict) -> Scene:
     base = None
     if "generator" in scene_cfg:
         seed = scene_cfg.get("seed", 0)
-        if not isinstance(seed, int):
-            raise ProblemFileError(f"[scene] seed: expected an integer, got {seed!r}")
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise ProblemFileError(f"[scene] seed: expected an integer ≥ 0, got {seed!r}")
+        generator = scene_cfg["generator"]
+        if not isinstance(generator, str):
+            raise ProblemFileError(f"[scene] generator: expected a name, got {generator!r}")
         options = {k: v for k, v in scene_cfg.items() if k not in ("generator", "seed")}
-        base = make_scene(scene_cfg["generator"], seed=seed, **options)
+        base = _call("[scene]", make_scene, generator, seed=seed, **options)
         obstacles += list(base.obstacles)
         name, info = base.name, dict(base.info)
     if "name" in robot_cfg:
         options = {k: v for k, v in robot_cfg.items() if k != "name"}
-        robot = load_robot(robot_cfg["name"], **options)
+        if not isinstance(robot_cfg["name"], str):
+            raise ProblemFileError(f"[robot] name: expected a name, got {robot_cfg['name']!r}")
+        robot = _call("[robot]", load_robot, robot_cfg["name"], **options)
     elif base is not None:
         robot = base.robot
     else:
@@ -219,8 +265,22 @@ def scene_from_config(cfg: dict) -> Scene:
     for i, item in enumerate(extra):
         if not isinstance(item, dict) or "polygon" not in item:
             raise ProblemFileError(f"[[obstacles]] #{i}: missing 'polygon = [[x, y], ...]'")
+        if set(item) != {"polygon"}:
+            unknown = sorted(set(item) - {"polygon"})
+            raise ProblemFileError(f"[[obstacles]] #{i}: unknown key(s) {unknown}; only polygon")
         try:
             obstacles.append(as_polygon(item["polygon"], f"obstacles[{i}].polygon"))
         except InputError as e:
             raise ProblemFileError(str(e)) from e
-    return Scene(robot, tuple(obstacles), name=name, seed=seed, info=info)
+    return _call("[[obstacles]]", Scene, robot, tuple(obstacles), name=name, seed=seed, info=info)
+
+
+def _call(where: str, factory: Callable, *args, **options):
+    """factory(*args, **options), with an unsupported option or a bad value (TypeError,
+    InputError) reported as a ProblemFileError naming the table."""
+    try:
+        return factory(*args, **options)
+    except UnknownNameError:
+        raise
+    except (TypeError, InputError) as e:
+        raise ProblemFileError(f"{where}: {e}") from e

@@ -42,6 +42,20 @@ from .casadi_bridge import DistanceCallback, supports_per_link
 from .ccd import Certificate, certify_path, verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, ProblemFileError
+from .limits import (
+    MAX_ADAM_ITERATIONS,
+    MAX_CHECK_POINTS,
+    MAX_INTERPOLATED,
+    MAX_ITER,
+    MAX_REFINE_ROUNDS,
+    MAX_RRT_TIME,
+    MAX_STARTS,
+    MAX_WAYPOINTS,
+    check_int,
+    check_ipopt,
+    check_number,
+    is_number,
+)
 from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot
 from .rrt import seed_path
@@ -94,11 +108,11 @@ class Problem:
         start: (dof,) start joint angles (rad).
         goal: (dof,) goal joint angles (rad), or None when ``goal_position`` is given.
         goal_position: (2,) end-effector goal in the plane (m), or None.
-        waypoints: T ≥ 3, waypoints including start and goal.
+        waypoints: 3 ≤ T ≤ ``limits.MAX_WAYPOINTS`` (500), waypoints including start and goal.
         margin: required clearance d ≥ margin (m).
         max_step: largest change of any joint between consecutive waypoints (rad).
         goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
-        lower, upper: (dof,) joint limits (rad); the robot's limits when None.
+        lower, upper: (dof,) joint limits (rad), within the robot's; the robot's when None.
         solver: the solver settings this problem needs (a problem file's ``[solver]`` table,
             e.g. short RRT-Connect steps for a narrow passage); :func:`plan` uses them unless
             it is given ``options``. None: the defaults.
@@ -136,15 +150,30 @@ class Problem:
             set_(self, "goal", _vector(self.goal, robot.dof, "goal.q"))
         else:
             set_(self, "goal_position", _vector(self.goal_position, 2, "goal.position"))
-        if not (isinstance(self.waypoints, int) and self.waypoints >= 3):
-            raise InputError(f"options.waypoints: expected an integer ≥ 3, got {self.waypoints!r}")
-        for name in ("margin", "max_step", "goal_tolerance"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise InputError(f"options.{name}: expected a finite number ≥ 0, got {value!r}")
-        if self.max_step <= 0 or self.goal_tolerance <= 0:
-            raise InputError("options.max_step and options.goal_tolerance must be > 0")
+        check_int(self.waypoints, "options.waypoints", 3, MAX_WAYPOINTS)
+        check_number(self.margin, "options.margin")
+        check_number(self.max_step, "options.max_step", strict=True)
+        check_number(self.goal_tolerance, "options.goal_tolerance", strict=True)
+        self._check_limits()
+        if self.solver is not None and not isinstance(self.solver, TrajoptOptions):
+            raise InputError(f"solver: expected TrajoptOptions, got {type(self.solver).__name__}")
         self._check_feasible()
+
+    def _check_limits(self) -> None:
+        """lower < upper, both within the robot's own joint limits."""
+        robot = self.scene.robot
+        for name, value in (("lower", self.lower), ("upper", self.upper)):
+            out = np.flatnonzero((value < robot.lower - 1e-9) | (value > robot.upper + 1e-9))
+            if out.size:
+                j = int(out[0])
+                raise InputError(
+                    f"options.{name}[{j}] = {value[j]:.4g} is outside the robot's joint range "
+                    f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}]; narrow it"
+                )
+        flat = np.flatnonzero(self.lower >= self.upper)
+        if flat.size:
+            j = int(flat[0])
+            raise InputError(f"options.lower[{j}] must be below options.upper[{j}]")
 
     def _check_feasible(self) -> None:
         """Start and goal inside the limits and clear of obstacles, goal position in reach."""
@@ -184,13 +213,7 @@ class Problem:
     @classmethod
     def from_toml(cls, path: str | Path) -> Problem:
         """Load a problem file (schema in DESIGN.md); ProblemFileError names any bad field."""
-        path = Path(path)
-        try:
-            cfg = tomllib.loads(path.read_text())
-        except OSError as e:
-            raise ProblemFileError(f"{path}: cannot read the problem file ({e.strerror})") from e
-        except tomllib.TOMLDecodeError as e:
-            raise ProblemFileError(f"{path}: malformed TOML: {e}") from e
+        cfg = read_problem_file(path)
         try:
             return cls.from_config(cfg)
         except ProblemFileError as e:
@@ -232,6 +255,39 @@ class Problem:
             raise ProblemFileError(str(e)) from e
 
 
+def read_problem_file(path: str | Path) -> dict:
+    """The parsed TOML mapping of a problem file; ProblemFileError when it cannot be read, is
+    not UTF-8 text, is malformed or nests deeper than Python's parser can follow."""
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as e:
+        raise ProblemFileError(f"{path}: cannot read the problem file ({e.strerror})") from e
+    except UnicodeDecodeError as e:
+        raise ProblemFileError(f"{path}: not UTF-8 text (byte {e.start}); save it as UTF-8") from e
+    except tomllib.TOMLDecodeError as e:
+        raise ProblemFileError(f"{path}: malformed TOML: {e}") from e
+    except RecursionError as e:
+        raise ProblemFileError(f"{path}: arrays or tables nest too deeply; flatten them") from e
+
+
+def problem_start(cfg: dict, scene: Scene) -> np.ndarray | None:
+    """The checked ``[start] q`` of a parsed problem file (None when absent), for drawing;
+    the ``[solver]`` table is checked too (what ``plan`` rejects, ``show`` rejects)."""
+    _solver_options(cfg.get("solver"))
+    start = cfg.get("start")
+    if start is None:
+        return None
+    if not isinstance(start, dict):
+        raise ProblemFileError("[start]: expected a table with q = [...]")
+    if "q" not in start:
+        return None
+    try:
+        return _vector(start["q"], scene.robot.dof, "start.q")
+    except InputError as e:
+        raise ProblemFileError(str(e)) from e
+
+
 def _solver_options(table: dict | None) -> TrajoptOptions | None:
     """TrajoptOptions from a problem file's ``[solver]`` table (None when absent)."""
     if table is None:
@@ -249,7 +305,10 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
             names = {float: "a number", int: "an integer", bool: "true or false"}
             wanted = names.get(type(default), f"a {type(default).__name__}")
             raise ProblemFileError(f"[solver] {key}: expected {wanted}, got {value!r}")
-    return replace(defaults, **table)
+    try:
+        return replace(defaults, **table)
+    except InputError as e:
+        raise ProblemFileError(f"[solver] {e}") from e
 
 
 def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
@@ -259,7 +318,10 @@ def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
 
 
 def _vector(value, n: int, name: str) -> np.ndarray:
-    """A finite float (n,) vector or InputError naming the field."""
+    """A finite float (n,) vector or InputError naming the field (no strings, no booleans)."""
+    items = value.tolist() if isinstance(value, np.ndarray) else value
+    if not isinstance(items, (list, tuple)) or not all(is_number(x) for x in items):
+        raise InputError(f"{name}: expected a list of {n} numbers, got {value!r}")
     try:
         v = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as e:
@@ -330,7 +392,10 @@ def solve_ik(
 # -------------------------------------------------------------------- plan
 @dataclass(frozen=True)
 class TrajoptOptions:
-    """Solver settings (defaults are the benchmarked configuration).
+    """Solver settings (defaults are the benchmarked configuration), checked when made:
+    a wrong type, NaN/inf or a value past its limit (:mod:`gdnplan.limits`: refine_rounds ≤ 8,
+    interpolated ≤ 50, 1 ≤ starts ≤ 50, 1 ≤ max_iter ≤ 10 000, 1 ≤ adam_iterations ≤ 100 000,
+    0 < rrt_time ≤ 600 s, ipopt options from an allow-list) is an InputError.
 
     Attributes:
         initial: "auto" (straight line when certified free, else RRT-Connect seeds),
@@ -398,6 +463,31 @@ class TrajoptOptions:
     adam_c: float = 1e-3
     adam_eps: float = 1e-3
     adam_stop: float = 0.01
+
+    def __post_init__(self) -> None:
+        """InputError naming the setting for a wrong type, NaN/inf or a value past its limit
+        (limits in :mod:`gdnplan.limits`)."""
+        if self.initial not in INITIAL_GUESSES:
+            raise InputError(f"initial: unknown {self.initial!r}; choose one of {INITIAL_GUESSES}")
+        for name in ("ccd", "warm_start") + (("per_link",) if self.per_link is not None else ()):
+            if not isinstance(getattr(self, name), bool):
+                raise InputError(f"{name}: expected true or false, got {getattr(self, name)!r}")
+        check_int(self.refine_rounds, "refine_rounds", 0, MAX_REFINE_ROUNDS)
+        if self.interpolated is not None:
+            check_int(self.interpolated, "interpolated", 0, MAX_INTERPOLATED)
+        if self.raise_window is not None:
+            check_int(self.raise_window, "raise_window", 0, MAX_WAYPOINTS)
+        check_int(self.starts, "starts", 1, MAX_STARTS)
+        check_int(self.max_iter, "max_iter", 1, MAX_ITER)
+        check_int(self.adam_iterations, "adam_iterations", 1, MAX_ADAM_ITERATIONS)
+        for name in ("tol", "obj_change_tol", "rrt_step", "link_cap", "adam_lr", "adam_c"):
+            check_number(getattr(self, name), name, strict=True)
+        check_number(self.adam_eps, "adam_eps", strict=True)
+        for name in ("rrt_clearance", "learned_margin", "adam_stop"):
+            check_number(getattr(self, name), name)
+        if check_number(self.rrt_time, "rrt_time", strict=True) > MAX_RRT_TIME:
+            raise InputError(f"rrt_time: {self.rrt_time} s is over the limit {MAX_RRT_TIME} s")
+        check_ipopt(self.ipopt)
 
 
 @dataclass(frozen=True, eq=False)
@@ -489,8 +579,10 @@ def plan(
     """
     t0 = time.perf_counter()
     opts = options or problem.solver or TrajoptOptions()
-    if opts.initial not in INITIAL_GUESSES:
-        raise InputError(f"initial: unknown {opts.initial!r}; choose one of {INITIAL_GUESSES}")
+    if not isinstance(opts, TrajoptOptions):
+        raise InputError(f"options: expected TrajoptOptions, got {type(opts).__name__}")
+    opts = replace(opts)  # re-runs the checks (a frozen dataclass can still be forged)
+    _check_sizes(problem, opts, solver)
     model = resolve_model(collision, problem.scene, weights)
     goal = problem.goal if problem.goal is not None else solve_ik(problem, seed)
     if solver == "ipopt":
@@ -500,6 +592,18 @@ def plan(
     else:
         raise InputError(f"solver: unknown {solver!r}; choose 'ipopt' or 'adam'")
     return _finish(problem, run, t0)
+
+
+def _check_sizes(problem: Problem, opts: TrajoptOptions, solver: str) -> None:
+    """InputError when the first solve would exceed ``MAX_CHECK_POINTS`` check points."""
+    default = IPOPT_INTERPOLATED if solver == "ipopt" else ADAM_INTERPOLATED
+    per_segment = (default if opts.interpolated is None else opts.interpolated) + opts.starts
+    total = (problem.waypoints - 1) * per_segment
+    if total > MAX_CHECK_POINTS:
+        raise InputError(
+            f"options.waypoints × solver.interpolated: {total} check points, the limit is "
+            f"{MAX_CHECK_POINTS}; use fewer waypoints or check points"
+        )
 
 
 @dataclass

@@ -1,5 +1,7 @@
 """Seed paths: RRT-Connect, shortcutting and resampling, every edge certified by coal."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -70,3 +72,26 @@ def test_seed_path_has_the_waypoint_count(clutter):
     guess, res = rrt.seed_path(problem.scene, problem.start, problem.goal, 20, 0.04, seed=0)
     assert res.success and guess.shape == (20, problem.scene.robot.dof)
     assert certify_path(problem.scene, guess, margin=0.04).ok  # resampling stays on the path
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"step": 0.0}, "rrt_step"),
+        ({"step": -1.0}, "rrt_step"),
+        ({"step": float("nan")}, "rrt_step"),
+        ({"time_limit": -1.0}, "rrt_time"),
+        ({"time_limit": float("inf")}, "rrt_time"),
+        ({"clearance": float("nan")}, "clearance"),
+        ({"max_iterations": 0}, "max_iterations"),
+    ],
+)
+def test_rrt_connect_rejects_settings_that_never_end(square, kwargs, field):
+    with pytest.raises(gp.InputError, match=field):
+        rrt.rrt_connect(square, START, GOAL, **kwargs)
+
+
+def test_rrt_connect_stops_at_the_time_limit_inside_the_connect_loop(square):
+    t0 = time.perf_counter()  # a tiny step: one greedy connect would take ~10⁶ extensions
+    res = rrt.rrt_connect(square, START, GOAL, step=1e-6, time_limit=0.5, seed=0)
+    assert not res.success and time.perf_counter() - t0 < 5.0

@@ -3,6 +3,8 @@ import pytest
 from shapely.geometry import Point, Polygon
 
 import gdnplan as gp
+import gdnplan.scene as scene_mod
+from gdnplan import geometry
 from gdnplan.scene import scene_from_config
 
 PAPER_ENVS = ["a", "b", "c", "d", "e"]
@@ -90,3 +92,41 @@ def test_scene_from_config_combines_generator_and_polygons():
 def test_bad_scene_config_names_the_field(cfg, error, field):
     with pytest.raises(error, match=field):
         scene_from_config(cfg)
+
+
+def test_scene_rejects_obstacles_far_beyond_the_reach():
+    robot = gp.make_scene("a").robot
+    bound = scene_mod.coordinate_bound(robot)
+    far = geometry.square((bound + 1.0, 0.0), 0.3)
+    with pytest.raises(gp.InputError, match=r"obstacles\[1\].*limit"):
+        scene_mod.Scene(robot, (geometry.square((0.6, 0.45), 0.3), far))
+    scene_mod.Scene(robot, (geometry.square((bound - 1.0, 0.0), 0.3),))
+
+
+def test_scene_rejects_a_thin_sliver_before_coal_sees_it():
+    robot = gp.make_scene("a").robot
+    sliver = np.array([[0.5, 0.5], [1.5, 0.5], [1.0, 0.5 + 1e-8]])
+    with pytest.raises(gp.InputError, match=r"obstacles\[0\].*thick"):
+        scene_mod.Scene(robot, (sliver,))
+
+
+@pytest.mark.parametrize(
+    ("cfg", "field"),
+    [
+        ({"robot": {"name": "planar2"}, "scene": {"generator": "a", "seed": -1}}, "seed"),
+        ({"robot": {"name": "planar2"}, "scene": {"generator": "a", "seed": True}}, "seed"),
+        ({"robot": {"name": "planar2"}, "scene": {"generator": "a", "bogus": 1}}, r"\[scene\]"),
+        ({"robot": {"name": "ur5e", "bogus": 1}}, r"\[robot\]"),
+        ({"robot": {"name": 3}}, "name"),
+        (
+            {
+                "robot": {"name": "planar2"},
+                "obstacles": [{"polygon": [[1, 0], [2, 0], [2, 1]], "x": 1}],
+            },
+            "unknown",
+        ),
+    ],
+)
+def test_scene_config_errors_are_problem_file_errors(cfg, field):
+    with pytest.raises(gp.ProblemFileError, match=field):
+        scene_mod.scene_from_config(cfg)

@@ -338,3 +338,84 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
     expected_raised = trajopt._check_point_raise(splits, near.astype(float)) > 0
     assert (second > p.margin).tolist() == expected_raised.tolist()
     assert 0 < expected_raised.sum() < len(second)  # some check points keep the plain margin
+
+
+@pytest.mark.parametrize(
+    ("settings", "field"),
+    [
+        ({"refine_rounds": -1}, "refine_rounds"),
+        ({"refine_rounds": 100}, "refine_rounds"),
+        ({"adam_iterations": 0}, "adam_iterations"),
+        ({"max_iter": -5}, "max_iter"),
+        ({"starts": 0}, "starts"),
+        ({"interpolated": 100_000}, "interpolated"),
+        ({"interpolated": "x"}, "interpolated"),
+        ({"per_link": "yes"}, "per_link"),
+        ({"raise_window": 1.5}, "raise_window"),
+        ({"tol": float("nan")}, "tol"),
+        ({"learned_margin": float("inf")}, "learned_margin"),
+        ({"rrt_clearance": float("nan")}, "rrt_clearance"),
+        ({"link_cap": -1.0}, "link_cap"),
+        ({"rrt_time": -1.0}, "rrt_time"),
+        ({"rrt_step": 0.0}, "rrt_step"),
+        ({"ccd": 1}, "ccd"),
+        ({"initial": "nope"}, "initial"),
+        ({"ipopt": {"no_such_option": 1}}, "no_such_option"),
+        ({"ipopt": {"mu_init": "x"}}, "mu_init"),
+        ({"ipopt": {"mu_strategy": "fast"}}, "mu_strategy"),
+        ({"ipopt": {"max_iter": 2.5}}, "max_iter"),
+        ({"ipopt": []}, "ipopt"),
+    ],
+)
+def test_trajopt_options_reject_bad_settings(settings, field):
+    with pytest.raises(gp.InputError, match=field):
+        TrajoptOptions(**settings)
+
+
+def _cfg(**tables) -> dict:
+    cfg = {
+        "robot": {"name": "planar2"},
+        "scene": {"generator": "a"},
+        "start": {"q": [2.006, -0.737]},
+        "goal": {"q": [1.448, -2.722]},
+    }
+    cfg.update(tables)
+    return cfg
+
+
+@pytest.mark.parametrize(
+    ("tables", "field"),
+    [
+        ({"start": {"q": ["2.006", -0.737]}}, "start.q"),
+        ({"start": {"q": [True, -0.737]}}, "start.q"),
+        ({"start": {"q": [[2.0], -0.737]}}, "start.q"),
+        ({"options": {"margin": True}}, "margin"),
+        ({"options": {"waypoints": 10**9}}, "waypoints"),
+        ({"options": {"waypoints": True}}, "waypoints"),
+        ({"options": {"lower": [-10.0, -10.0]}}, "lower"),
+        ({"options": {"lower": [0.5, -3.0], "upper": [0.5, 3.0]}}, "lower"),
+        ({"solver": {"per_link": "yes"}}, "per_link"),
+        ({"solver": {"refine_rounds": -1}}, "refine_rounds"),
+        ({"solver": {"ipopt": {"foo": 1}}}, "foo"),
+        ({"solver": {"interpolated": 50, "starts": 50}, "options": {"waypoints": 500}}, None),
+    ],
+)
+def test_problem_config_rejects_bad_values_as_problem_file_errors(tables, field):
+    if field is None:  # valid alone, but too many check points together: plan refuses
+        problem = Problem.from_config(_cfg(**tables))
+        with pytest.raises(gp.InputError, match="check points"):
+            plan(problem, collision="coal")
+        return
+    with pytest.raises(gp.ProblemFileError, match=field):
+        Problem.from_config(_cfg(**tables))
+
+
+@pytest.mark.parametrize(
+    "text",
+    [b"\xff\xfe\x00garbage", b"x = " + b"[" * 5000 + b"]" * 5000, b"[start\nq = 1"],
+)
+def test_unreadable_problem_files_are_problem_file_errors(tmp_path, text):
+    path = tmp_path / "bad.toml"
+    path.write_bytes(text)
+    with pytest.raises(gp.ProblemFileError):
+        Problem.from_toml(path)
