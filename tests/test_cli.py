@@ -40,7 +40,7 @@ def test_show_from_problem_file(tmp_path):
         (["show", "zz"], "scene: unknown name"),
         (["show", "d", "--q", "1,2"], "--q: expected shape"),
         (["show", "d", "--q", "1,x"], "--q: expected numbers"),
-        (["show", "missing.toml"], "no such file"),
+        (["show", "missing.toml"], "No such file"),
     ],
 )
 def test_bad_input_prints_one_line_and_exits_2(args, message):
