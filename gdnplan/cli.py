@@ -114,9 +114,10 @@ def problem_scene_and_start(path: Path) -> tuple[Scene, np.ndarray | None]:
 
 def check_limits(robot, q: np.ndarray, name: str) -> np.ndarray:
     """``q`` (dof,) when it is within the robot's joint limits; InputError naming the joint."""
-    bad = np.flatnonzero((q < robot.lower - 1e-9) | (q > robot.upper + 1e-9))
-    if bad.size:
-        j = int(bad[0])
+    from .robot import first_outside
+
+    j = first_outside(q, robot.lower, robot.upper)
+    if j is not None:
         raise InputError(
             f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
             f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}] of {robot.name}"

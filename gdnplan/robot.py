@@ -328,6 +328,12 @@ def _joint_axis(model: pin.Model, j: int) -> np.ndarray:
     raise InputError(f"joint {model.names[j]!r}: only revolute joints can be planning joints")
 
 
+def first_outside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, tol: float = 1e-9):
+    """Index of the first joint of q (dof,) outside [lower − tol, upper + tol], or None."""
+    out = np.flatnonzero((q < lower - tol) | (q > upper + tol))
+    return int(out[0]) if out.size else None
+
+
 def as_batch(q: np.ndarray, dof: int, name: str = "q") -> np.ndarray:
     """Return q as a float64 (B, dof) array; a single (dof,) configuration becomes (1, dof)."""
     try:

@@ -57,7 +57,7 @@ from .limits import (
     is_number,
 )
 from .models import CoalModel, DistanceModel, load_model
-from .robot import Robot
+from .robot import Robot, first_outside
 from .rrt import seed_path
 from .scene import Scene, scene_from_config
 
@@ -163,9 +163,8 @@ class Problem:
         """lower < upper, both within the robot's own joint limits."""
         robot = self.scene.robot
         for name, value in (("lower", self.lower), ("upper", self.upper)):
-            out = np.flatnonzero((value < robot.lower - 1e-9) | (value > robot.upper + 1e-9))
-            if out.size:
-                j = int(out[0])
+            j = first_outside(value, robot.lower, robot.upper)
+            if j is not None:
                 raise InputError(
                     f"options.{name}[{j}] = {value[j]:.4g} is outside the robot's joint range "
                     f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}]; narrow it"
@@ -181,9 +180,8 @@ class Problem:
             [("goal.q", self.goal)] if self.goal is not None else []
         )
         for name, q in named:
-            out = np.flatnonzero((q < self.lower - 1e-9) | (q > self.upper + 1e-9))
-            if out.size:
-                j = int(out[0])
+            j = first_outside(q, self.lower, self.upper)
+            if j is not None:
                 raise InfeasibleProblemError(
                     f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
                     f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
