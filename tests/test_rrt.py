@@ -1,7 +1,5 @@
 """Seed paths: RRT-Connect, shortcutting and resampling, every edge certified by coal."""
 
-import time
-
 import numpy as np
 import pytest
 
@@ -91,7 +89,23 @@ def test_rrt_connect_rejects_settings_that_never_end(square, kwargs, field):
         rrt.rrt_connect(square, START, GOAL, **kwargs)
 
 
-def test_rrt_connect_stops_at_the_time_limit_inside_the_connect_loop(square):
-    t0 = time.perf_counter()  # a tiny step: one greedy connect would take ~10⁶ extensions
+def test_rrt_connect_stops_at_the_time_limit_inside_the_connect_loop(square, monkeypatch):
+    """A tiny step: one greedy connect would take ~10⁶ extensions. On a clock that advances
+    10 ms per reading, a 0.5 s limit must stop the search after a few dozen edge checks."""
+    now, checks = [0.0], [0]
+
+    def clock() -> float:
+        now[0] += 0.01
+        return now[0]
+
+    def counted(*args, **kwargs):
+        checks[0] += 1
+        if checks[0] > 1000:
+            raise AssertionError("the connect loop ignores the time limit")
+        return edge_free(*args, **kwargs)
+
+    edge_free = rrt.edge_free
+    monkeypatch.setattr(rrt.time, "perf_counter", clock)
+    monkeypatch.setattr(rrt, "edge_free", counted)
     res = rrt.rrt_connect(square, START, GOAL, step=1e-6, time_limit=0.5, seed=0)
-    assert not res.success and time.perf_counter() - t0 < 5.0
+    assert not res.success and 0 < checks[0] <= 100
