@@ -39,6 +39,7 @@ import numpy as np
 
 from .distance import signed_distance
 from .errors import InputError
+from .limits import check_int, check_number, is_number
 from .robot import Robot
 from .scene import Scene
 
@@ -115,18 +116,11 @@ class Certificate:
 
 
 def _check_args(margin: float, tol: float, min_splits: int, max_checks: int) -> None:
-    def number(x) -> bool:
-        return isinstance(x, (int, float, np.floating, np.integer)) and not isinstance(x, bool)
-
-    if not (number(margin) and math.isfinite(margin) and margin >= 0):
-        raise InputError(f"margin: expected a finite number ≥ 0 (m), got {margin!r}")
-    if not (number(tol) and tol > 0) or math.isnan(tol):
+    check_number(margin, "margin")
+    if not (is_number(tol) and tol > 0) or math.isnan(tol):
         raise InputError(f"tol: expected a number > 0 (m) or inf, got {tol!r}")
-    for name, value in (("min_splits", min_splits), ("max_checks", max_checks)):
-        if not (
-            isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= 1
-        ):
-            raise InputError(f"{name}: expected an integer ≥ 1, got {value!r}")
+    check_int(min_splits, "min_splits", 1, 10**6)
+    check_int(max_checks, "max_checks", 1, 10**9)
 
 
 def _initial_pieces(q_path: np.ndarray, splits: int):
