@@ -25,10 +25,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from .assets import robot_urdf
 from .errors import InputError, UnknownNameError
 from .geometry import convex_hull, simplify_convex
-
-ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
 
 
 def rot2(theta: np.ndarray) -> np.ndarray:
@@ -556,7 +555,7 @@ _CACHE: dict[str, Robot] = {}
 
 def _planar(name: str) -> Robot:
     spec = RobotSpec(
-        urdf=ROBOTS_DIR / f"{name}.urdf",
+        urdf=robot_urdf(name),
         planning_joints=tuple(f"joint{i}" for i in range(1, int(name[-1]) + 1)),
     )
     return robot_from_urdf(name, spec)
