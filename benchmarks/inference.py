@@ -21,16 +21,13 @@ import os
 import subprocess
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import torch
 from torch.utils.flop_counter import FlopCounterMode
 
 import gdnplan as gp
 from gdnplan import distance
-
-WEIGHTS = Path(__file__).resolve().parent.parent / "weights"
-WEIGHTS_FOR_SCENE = {"fetch": "ur5e"}  # scene name -> weights name, where they differ
+from gdnplan.assets import default_weights
 
 
 def best_time(fn: Callable[[], object], repeats: int) -> float:
@@ -65,14 +62,11 @@ def machine() -> str:
     return f"{name}, {os.cpu_count()} cores, torch {torch.__version__}"
 
 
-def row(env: str, n: int, repeats: int, peak: float, weights: Path = WEIGHTS) -> str:
+def row(env: str, n: int, repeats: int, peak: float) -> str:
     """One table row: seconds of coal and GraphDistNet for n configurations of scene ``env``."""
-    path = weights / f"{WEIGHTS_FOR_SCENE.get(env, env)}.safetensors"
-    if not path.exists():
-        return f"| {env} | (no weights at {path.name}) ||||||"
     scene = gp.make_scene(env, seed=0)
     q = scene.robot.sample(n, seed=0)
-    model = gp.load_model(path)
+    model = gp.load_model(default_weights(scene))
     distance.checker(scene)
     calls = {
         "coal d": lambda: gp.signed_distance(scene, q),
@@ -96,13 +90,12 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--envs", nargs="+", default=["a", "b", "c", "d", "e", "fetch"])
     parser.add_argument("--threads", type=int, default=1, help="torch intra-op threads")
-    parser.add_argument("--weights", type=Path, default=WEIGHTS, help="weights directory")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     peak = matmul_gflops()
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
     print(f"machine: {machine()}; torch threads {args.threads}; n = {args.n}; {now}")
-    print(f"weights: {args.weights}")
+    print("weights: the shipped default of each scene (gdnplan.assets.default_weights)")
     print(f"load average at start: {os.getloadavg()}")
     print(f"float32 matmul peak ({args.threads} threads): {peak:.1f} GFLOP/s")
     print(
@@ -111,7 +104,7 @@ def main() -> None:
     )
     print("|---|---|---|---|---|---|---|---|")
     for env in args.envs:
-        print(row(env, args.n, args.repeats, peak, args.weights), flush=True)
+        print(row(env, args.n, args.repeats, peak), flush=True)
     print(f"load average at end: {os.getloadavg()}")
 
 

@@ -1,0 +1,222 @@
+"""Continuous collision certificates for joint-space segments (conservative advancement).
+
+Along the straight joint-space segment q(s) = q_a + s (q_b − q_a), s ∈ [0, 1], a robot point p
+on link l moves with ṗ = Σ_j s_j ẑ × (p − o_j(q)) Δq_j and |p − o_j(q)| ≤ r_{l,j}, the largest
+lever arm from joint j to any vertex of link l (a rigid, configuration-independent bound, chained
+through the joint-to-joint distances; the farthest point of a polygon from any point is a vertex).
+So no point of link l travels farther than
+
+    δ_l(q_a, q_b) = Σ_j r_{l,j} |Δq_j|                                        (m)
+
+along the piece. If the robot at q_a is apart from the obstacles by d_a > s δ, no point of the
+robot at q(s) can lie in an obstacle closer than d_a − s δ (its preimage at q_a would be closer
+than d_a), so d(q(s)) ≥ d_a − s δ, and likewise d(q(s)) ≥ d_b − (1 − s) δ. The larger of the two
+is at least their mean:
+
+    d(q(s)) ≥ L(q_a, q_b) = (d_a + d_b − δ) / 2     for every s ∈ [0, 1] when L ≥ 0.   (1)
+
+coal's distances are GJK estimates that stop once the estimate is within a tolerance τ of the
+separating-plane lower bound, d_coal − d ≤ τ (1 + d_coal) (DistanceRequest.gjk_tolerance); the
+certificate uses the proven lower bound d̲ = d_coal − ``COAL_SLACK`` (1 + |d_coal|) in place of d,
+with ``COAL_SLACK`` = 2 τ. (A test compares coal with shapely's exact planar distances.)
+
+:func:`certify_path` splits every waypoint segment into pieces and bisects (all open pieces per
+round, one batched coal call) until every piece is proven by (1) to stay above the margin — or
+a checked configuration is within the margin (a counterexample), a piece shrinks below
+``MIN_PIECE`` without a proof, or the check budget runs out: all three are failures, never
+acceptances. Pieces are also bisected until their bound is within ``tol`` of the smallest
+checked distance, so the reported lower bound is at most ``tol`` below the path's true minimum.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cache
+
+import coal
+import numpy as np
+
+from .distance import signed_distance
+from .errors import InputError
+from .limits import check_int, check_number, is_number
+from .robot import Robot
+from .scene import Scene
+
+COAL_SLACK = 2 * coal.DistanceRequest().gjk_tolerance  # relative error allowance of coal (m/m)
+MIN_PIECE = 1e-9  # m: a piece whose robot points move less than this is not bisected further
+
+
+@cache
+def _lever_arms(robot: Robot) -> np.ndarray:
+    o = robot.chain.joint_origins  # (dof, 2) at q = 0; distances are rigid
+    hops = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(o, axis=0), axis=1))])
+    arms = np.zeros((robot.n_links, robot.dof))
+    for node, p0 in enumerate(robot.nodes0):
+        link, body = robot.node_polygon[node], robot.node_body[node]
+        if body == 0:
+            continue
+        last = body - 1  # the joint the node's body hangs from
+        reach = hops[last] - hops[: last + 1] + np.linalg.norm(p0 - o[last])  # joints 0..last
+        arms[link, : last + 1] = np.maximum(arms[link, : last + 1], reach)
+    return arms
+
+
+def lever_arms(robot: Robot) -> np.ndarray:
+    """(n_links, dof) bound r_{l,j} ≥ |p − o_j(q)| for every point p of link l, any q (m).
+
+    r_{l,j} = max_p Σ_{i=j}^{b−2} |o_{i+1} − o_i| + |p − o_{b−1}| over the vertices p of link l on
+    body b > j (joints 0-indexed), and 0 where joint j is downstream of the link.
+    """
+    return _lever_arms(robot)
+
+
+def motion_bound(
+    robot: Robot, qa: np.ndarray, qb: np.ndarray, per_link: bool = False
+) -> np.ndarray:
+    """Largest distance any robot point travels from qa to qb (B, dof) along the segment (m).
+
+    Returns (B,) = max_l δ_l, or (B, n_links) with ``per_link``; δ_l = Σ_j r_{l,j} |Δq_j|.
+    """
+    delta = np.abs(np.asarray(qb, float) - np.asarray(qa, float)) @ lever_arms(robot).T
+    return delta if per_link else delta.max(axis=1)
+
+
+def proven_distance(d_coal: np.ndarray) -> np.ndarray:
+    """Lower bound d̲ = d_coal − COAL_SLACK (1 + |d_coal|) on the exact distance (m)."""
+    return d_coal - COAL_SLACK * (1.0 + np.abs(d_coal))
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """Result of :func:`certify_path`.
+
+    The path's true minimum clearance lies in [lower_bound, min_distance]; when ``ok`` the two
+    are at most the requested ``tol`` apart.
+
+    Attributes:
+        ok: proven: the exact signed distance stays above the margin on the whole continuous
+            path (every piece's bound (1) > margin).
+        lower_bound: proven lower bound on the signed distance along the whole path (m), the
+            smallest bound (1) of all pieces; −inf when ``ok`` is False (nothing is proven).
+        min_distance: smallest coal distance over all checked configurations (m): an upper
+            bound on the path's minimum, and the counterexample's distance when it is ≤ margin.
+        n_checks: coal evaluations made.
+        bad_segments: indices of the waypoint segments holding a configuration within the
+            margin or a piece left unproven (too small to bisect, or out of check budget).
+        reason: why the certificate failed ("" when ``ok``).
+    """
+
+    ok: bool
+    lower_bound: float
+    min_distance: float
+    n_checks: int
+    bad_segments: tuple[int, ...]
+    reason: str = ""
+
+
+def _check_args(margin: float, tol: float, min_splits: int, max_checks: int) -> None:
+    check_number(margin, "margin")
+    if not (is_number(tol) and tol > 0) or math.isnan(tol):
+        raise InputError(f"tol: expected a number > 0 (m) or inf, got {tol!r}")
+    check_int(min_splits, "min_splits", 1, 10**6)
+    check_int(max_checks, "max_checks", 1, 10**9)
+
+
+def _initial_pieces(q_path: np.ndarray, splits: int):
+    """(qa, qb, seg): every waypoint segment split into ``splits`` equal pieces."""
+    if len(q_path) == 1:
+        return q_path, q_path, np.zeros(1, int)
+    s = np.linspace(0.0, 1.0, splits + 1)
+    step = (q_path[1:] - q_path[:-1])[:, None]
+    starts = (q_path[:-1, None] + s[None, :-1, None] * step).reshape(-1, q_path.shape[1])
+    ends = (q_path[:-1, None] + s[None, 1:, None] * step).reshape(-1, q_path.shape[1])
+    ends[splits - 1 :: splits] = q_path[1:]  # pieces meet the waypoints exactly
+    return starts, ends, np.repeat(np.arange(len(q_path) - 1), splits)
+
+
+def certify_path(
+    scene: Scene,
+    q_path: np.ndarray,
+    margin: float = 0.0,
+    tol: float = 1e-3,
+    min_splits: int = 10,
+    stop_early: bool = False,
+    max_checks: int = 200_000,
+) -> Certificate:
+    """Prove that the piecewise-linear joint path q_path (K, dof) keeps coal distance > margin.
+
+    Args:
+        scene: robot and obstacles.
+        q_path: (K, dof) waypoints (rad); K = 1 checks one configuration.
+        margin: clearance to prove (m), finite and ≥ 0.
+        tol: bisect until the reported lower bound is within ``tol`` of the smallest checked
+            distance (m); ``math.inf`` proves the margin only (fastest, e.g. for edge checks).
+        min_splits: pieces each waypoint segment starts with.
+        stop_early: return at the first configuration within the margin.
+        max_checks: coal evaluations allowed; running out is a failure.
+    """
+    _check_args(margin, tol, min_splits, max_checks)
+    robot = scene.robot
+    q_path = robot.check_q(q_path, "q_path")
+    qa, qb, seg = _initial_pieces(q_path, min_splits)
+    nodes = np.concatenate([qa, qb[-1:]])
+    raw = signed_distance(scene, nodes)
+    d_nodes = proven_distance(raw)
+    da, db = d_nodes[:-1], d_nodes[1:]
+    n_checks, best, raw_min = len(nodes), float(np.min(d_nodes)), float(np.min(raw))
+    lower, bad, reasons = math.inf, set(), []
+    while len(qa):
+        delta = motion_bound(robot, qa, qb)
+        bound = (da + db - delta) / 2
+        hit = (da <= margin) | (db <= margin)
+        if hit.any():
+            bad.update(seg[hit].tolist())
+            reasons.append("a checked configuration is within the margin")
+            if stop_early:
+                break
+        proven = ~hit & (bound > margin) & (bound >= best - tol)
+        stuck = ~hit & ~proven & (delta < MIN_PIECE)
+        if stuck.any():
+            bad.update(seg[stuck].tolist())
+            reasons.append("a piece too small to bisect has no proof")
+        if proven.any():
+            lower = min(lower, float(np.min(bound[proven])))
+        keep = ~(hit | proven | stuck)
+        if n_checks + int(keep.sum()) > max_checks:
+            bad.update(seg[keep].tolist())
+            reasons.append(f"the check budget ({max_checks} coal evaluations) ran out")
+            break
+        qa, qb, da, db, seg = qa[keep], qb[keep], da[keep], db[keep], seg[keep]
+        mid = (qa + qb) / 2
+        raw = signed_distance(scene, mid) if len(mid) else np.zeros(0)
+        dm = proven_distance(raw)
+        n_checks += len(mid)
+        if len(dm):
+            best, raw_min = min(best, float(np.min(dm))), min(raw_min, float(np.min(raw)))
+        qa, qb = np.concatenate([qa, mid]), np.concatenate([mid, qb])
+        da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
+        seg = np.concatenate([seg, seg])
+    ok = not bad
+    reason = "; ".join(dict.fromkeys(reasons))
+    return Certificate(
+        ok, lower if ok else -math.inf, raw_min, n_checks, tuple(sorted(bad)), reason
+    )
+
+
+def verify_path(scene: Scene, q_path: np.ndarray, margin: float = 0.0) -> tuple[bool, float]:
+    """Certified coal check of a joint path (K, dof): (proven to stay above ``margin``, proven
+    lower bound on its clearance in m, −inf when not proven)."""
+    cert = certify_path(scene, q_path, margin=margin)
+    return cert.ok, cert.lower_bound
+
+
+__all__ = [
+    "COAL_SLACK",
+    "Certificate",
+    "certify_path",
+    "lever_arms",
+    "motion_bound",
+    "proven_distance",
+    "verify_path",
+]

@@ -1,0 +1,650 @@
+"""The ``gdnplan`` command.
+
+Exit status: 0 success; 1 planning failed (``plan``, ``fetch``); 2 bad input (a
+:class:`~gdnplan.errors.GdnplanError` or a usage error: one line ``error: …`` naming the field and
+the fix); 3 internal error (any other exception: one line ``error: internal error (Type: message);
+rerun with --debug for the traceback``); 130 interrupted (Ctrl-C). ``gdnplan --debug <command> …``
+prints the traceback of errors 2 and 3 as well.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import traceback
+from pathlib import Path
+
+import numpy as np
+import typer
+
+try:  # typer ≥ 0.25 vendors click
+    from typer._click import exceptions as click_exceptions
+except ImportError:  # pragma: no cover - older typer depends on click
+    from click import exceptions as click_exceptions
+
+from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
+from .files import FIGURE_SUFFIXES, check_output_dir, check_output_path, write_text
+from .scene import Scene, make_scene, scene_from_config, scene_names
+
+app = typer.Typer(
+    help="Collision-free trajectory planning with GraphDistNet.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+
+
+EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
+_DEBUG = {"on": False}  # set by ``--debug`` (the callback runs before the command)
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from importlib.metadata import version
+
+        typer.echo(f"gdnplan {version('gdnplan')}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _commands(
+    debug: bool = typer.Option(False, "--debug", help="Print the traceback of any error."),
+    version: bool = typer.Option(
+        False, "--version", callback=_print_version, is_eager=True, help="Print the version."
+    ),
+) -> None:
+    """Collision-free trajectory planning with GraphDistNet."""
+    _DEBUG["on"] = debug
+
+
+WEIGHTS_HELP = (
+    "GraphDistNet weights: a shipped name (d, ur5e, …) or a .safetensors file "
+    "(default: the shipped weights for the problem's robot and obstacles)."
+)
+PROBLEM_HELP = "A problem TOML file or a shipped problem's name (fetch_reach, planar7_d, …)."
+
+
+THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
+
+
+def set_threads(threads: int) -> None:
+    """Set torch's intra-op threads; raises InputError unless threads ≥ 1."""
+    if threads < 1:
+        raise InputError(f"--threads: expected ≥ 1, got {threads}")
+    import torch
+
+    torch.set_num_threads(threads)
+
+
+def parse_vector(text: str, name: str) -> np.ndarray:
+    """'0.1, -0.2, 0.3' -> array; raises InputError naming ``name``."""
+    try:
+        return np.array([float(v) for v in text.replace(",", " ").split()])
+    except ValueError as e:
+        raise InputError(f"{name}: expected numbers separated by commas, got {text!r}") from e
+
+
+def read_toml(path: Path) -> dict:
+    """Parse a TOML file; raises ProblemFileError (unreadable, not UTF-8, malformed, too deep)."""
+    from .trajopt import read_problem_file
+
+    return read_problem_file(path)
+
+
+def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
+    """A scene from a problem file or shipped problem name (with its start q), or from a
+    scene generator name."""
+    from .assets import problem_names
+
+    if (
+        target.endswith(".toml")
+        or target in problem_names()
+        or (target not in scene_names() and Path(target).exists())
+    ):
+        return problem_scene_and_start(target)
+    return make_scene(target, seed=seed), None
+
+
+def problem_scene_and_start(path: str | Path) -> tuple[Scene, np.ndarray | None]:
+    """The scene and ``[start] q`` of a problem file, checked as ``plan`` checks it.
+
+    A file with a ``[goal]`` passes every check of :meth:`Problem.from_config` except the
+    feasibility ones (a start in collision is what ``show`` draws); a scene-only file (no
+    ``[goal]``, ``[start]`` optional) the checks of its tables. ProblemFileError names the file.
+    """
+    from .trajopt import TOP_KEYS, Problem, _no_unknown, _vector
+
+    cfg = read_toml(path)
+    try:
+        if "goal" in cfg:
+            try:
+                Problem.from_config(cfg)
+            except InfeasibleProblemError:
+                pass
+        _no_unknown(cfg, TOP_KEYS, "top level")
+        try:
+            scene = scene_from_config(cfg)
+        except TypeError as e:
+            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
+        start = cfg.get("start")
+        if start is None:
+            return scene, None
+        if not isinstance(start, dict) or "q" not in start:
+            raise ProblemFileError("[start]: expected a table with q = [start joint angles]")
+        q = _vector(start["q"], scene.robot.dof, "start.q")
+        return scene, check_limits(scene.robot, q, "start.q")
+    except GdnplanError as e:
+        raise ProblemFileError(f"{path}: {e}") from e
+
+
+def check_limits(robot, q: np.ndarray, name: str) -> np.ndarray:
+    """``q`` (dof,) when it is within the robot's joint limits; InputError naming the joint."""
+    from .robot import first_outside
+
+    j = first_outside(q, robot.lower, robot.upper)
+    if j is not None:
+        raise InputError(
+            f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
+            f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}] of {robot.name}"
+        )
+    return q
+
+
+@app.command()
+def show(
+    target: str = typer.Argument(
+        ..., help="A problem TOML file, a shipped problem's name or a scene name (a-e, fetch)."
+    ),
+    q: str = typer.Option(None, help="Joint angles 'q1,q2,...' (default: the problem's start)."),
+    seed: int = typer.Option(0, min=0, help="Scene seed, for generated scenes."),
+    out: Path = typer.Option(Path("scene.png"), help="Output PNG."),
+) -> None:
+    """Draw the robot, the obstacles and the witness segment of the signed distance."""
+    from .viz import save_figure, scene_figure
+
+    check_output_path(out, FIGURE_SUFFIXES, "--out")
+    scene, start = scene_and_start(target, seed)
+    if q is not None:
+        config = check_limits(
+            scene.robot, scene.robot.check_q(parse_vector(q, "--q"), "--q")[0], "--q"
+        )
+    else:
+        config = start
+    fig = scene_figure(scene, config)
+    save_figure(fig, out)
+    typer.echo(f"wrote {out}")
+
+
+@app.command("plan")
+def plan_command(
+    problem_file: str = typer.Argument(..., help=PROBLEM_HELP),
+    collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
+    solver: str = typer.Option("ipopt", help="ipopt (direct transcription) or adam (paper)."),
+    weights: str = typer.Option(None, help=WEIGHTS_HELP),
+    seed: int = typer.Option(0, min=0, help="Seed of the sampling-based initial guesses."),
+    json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
+    view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
+) -> None:
+    """Plan a collision-free trajectory; success is certified by a dense coal check.
+
+    Exit status: 0 when the plan is certified, 1 when planning failed, 2 on bad input.
+    """
+    from .trajopt import Problem, plan
+
+    if animate is not None:
+        check_output_path(animate, (".gif",), "--animate")
+    set_threads(threads)
+    if view3d:  # fail before planning, not after
+        from .viz3d import require_meshcat
+
+        require_meshcat()
+    problem = Problem.from_toml(problem_file)
+    result = plan(problem, collision=collision, solver=solver, weights=weights, seed=seed)
+    if json_output:
+        typer.echo(json.dumps(plan_summary(result)))
+    else:
+        verdict = "certified collision-free" if result.success else f"FAILED ({result.reason})"
+        typer.echo(
+            f"{problem_file}: {verdict}; {clearance_text(result.min_distance)}, "
+            f"solve time {result.solve_time:.2f} s, {result.iterations} iterations, "
+            f"path cost {result.path_cost:.3f}"
+        )
+    if animate is not None:
+        from .viz import animate_paths
+
+        animate_paths(
+            [(problem.scene, result.q)], animate, title=f"{Path(problem_file).name}: {collision}"
+        )
+        if not json_output:
+            typer.echo(f"wrote {animate}")
+    if view3d:
+        from .viz3d import view_plan
+
+        view_plan([(problem.scene, result.q)])
+    if not result.success:
+        raise typer.Exit(1)
+
+
+def clearance_text(lower_bound: float) -> str:
+    """'certified clearance ≥ +0.0123 m', or 'clearance not proven' for a −inf bound."""
+    if not np.isfinite(lower_bound):
+        return "clearance not proven"
+    return f"certified clearance ≥ {lower_bound:+.4f} m"
+
+
+def json_number(x: float) -> float | None:
+    """x as a JSON number; None (null) when not finite (JSON has no infinities)."""
+    return float(x) if np.isfinite(x) else None
+
+
+def plan_summary(result) -> dict:
+    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none)."""
+    return {
+        "success": bool(result.success),
+        "q": np.asarray(result.q).tolist(),
+        "min_distance": json_number(result.min_distance),
+        "sampled_min_distance": json_number(result.sampled_min_distance),
+        "solve_time": float(result.solve_time),
+        "iterations": int(result.iterations),
+        "status": result.status,
+        "reason": result.reason,
+        "path_cost": float(result.path_cost),
+    }
+
+
+reproduce_app = typer.Typer(help="Reproduce the paper's tables.", no_args_is_help=True)
+app.add_typer(reproduce_app, name="reproduce")
+
+EVAL_MODELS = ("coal", "diffco", "clearancenet", "graphdistnet")
+
+
+@app.command("evaluate")
+def evaluate_command(
+    env: str = typer.Option("a", help="Environment a-e (its held-out split, seed 1)."),
+    model: str = typer.Option("graphdistnet", help="coal | diffco | clearancenet | graphdistnet."),
+    n: int = typer.Option(5000, min=1, max=5000, help="Held-out samples (time, MAE, AUC)."),
+    n_grad: int = typer.Option(5000, min=1, help="Samples for the ACD (the first of the n)."),
+) -> None:
+    """Time, MAE, AUC and ACD of one collision model on held-out samples (Table I metrics)."""
+    from . import evaluate as ev
+    from .scene import make_scene
+
+    if model not in EVAL_MODELS:
+        raise InputError(f"--model: unknown {model!r}; choose one of {list(EVAL_MODELS)}")
+    if env not in ev.ENVS:
+        raise InputError(f"--env: expected one of {list(ev.ENVS)}, got {env!r}")
+    if model == "coal":
+        from .models import CoalModel
+
+        chosen = CoalModel()
+    elif model == "diffco":
+        from .models.diffco import DiffCo
+
+        chosen = DiffCo.train(make_scene(ev.DIFFCO_SOURCE.get(env, env)), n=3000)
+    else:
+        loader = ev.load_clearancenet if model == "clearancenet" else ev.load_graphdistnet
+        chosen = loader(env)
+        if chosen is None:
+            raise InputError(f"--model: no {model} weights for env {env} in weights/")
+    r = ev.evaluate_model(chosen, env, n, n_grad)
+    mae = "N/A" if r.mae is None else f"{r.mae:.4f} m ({r.mae_reach:.4f} of reach)"
+    acd = "N/A" if r.acd is None else f"{r.acd:.4f} ± {r.acd_se:.4f} over {r.n_grad}"
+    typer.echo(
+        f"{model} env {env}: n={r.n} time {r.seconds:.4f} s, MAE {mae}, AUC {r.auc:.4f}, ACD {acd}"
+    )
+
+
+@reproduce_app.command("table1")
+def table1_command(
+    fast: bool = typer.Option(False, "--fast", help="Few samples (CI); the full run is recorded."),
+    envs: str = typer.Option("abcde", help="Environments to run, e.g. 'ab'."),
+    out: Path = typer.Option(Path("results/table1.md"), help="Markdown output."),
+    figures: Path = typer.Option(None, help="Directory for ROC/scatter PNGs (default: none)."),
+    weights: Path = typer.Option(None, help="Directory of the trained weights (repo weights/)."),
+) -> None:
+    """The paper's Table I, ours beside the paper's numbers; markdown to stdout and ``out``."""
+    import datetime
+    import os
+    import platform
+
+    from . import evaluate as ev
+
+    check_output_path(out, (".md",), "--out")
+    if figures is not None:
+        check_output_dir(figures, "--figures")
+    weights = weights or ev.WEIGHTS_DIR
+    if not envs or any(e not in ev.ENVS for e in envs):
+        raise InputError(f"--envs: expected letters from 'abcde', got {envs!r}")
+    results, missing, used = ev.table1(
+        tuple(envs), fast, log=lambda m: typer.echo(m, err=True), weights_dir=weights
+    )
+    cpu = platform.processor() or platform.machine()
+    header = [
+        "# Table I reproduction" + (" (fast mode: few samples, not a result)" if fast else ""),
+        "",
+        f"- command: `gdnplan reproduce table1{' --fast' if fast else ''} --envs {envs}"
+        f" --weights {weights}`",
+        f"- date: {datetime.datetime.now().isoformat(timespec='seconds')}",
+        f"- machine: {platform.node()}, {cpu}, {os.cpu_count()} cores (shared), "
+        f"{platform.python_version()}",
+        f"- missing weights: {', '.join(missing) if missing else 'none'}",
+        f"- weights used (sha256 prefix, hashed at load): "
+        f"{', '.join(f'{k}:{v}' for k, v in used.items()) or 'none'}",
+        "",
+        "",
+    ]
+    text = "\n".join(header) + ev.table1_markdown(results) + "\n"
+    typer.echo(text)
+    write_text(out, text, "--out")
+    if figures is not None:
+        for path in ev.table1_figures(results, figures):
+            typer.echo(f"wrote {path}", err=True)
+
+
+@reproduce_app.command("table2")
+def table2_command(
+    n: int = typer.Option(20, help="Problems per setting (the paper: 20)."),
+    settings: str = typer.Option("b,d,fetch", help="Settings: b, d, fetch (comma-separated)."),
+    methods: str = typer.Option(
+        "GraphDistNet,ClearanceNet,DiffCo,coal", help="Collision models (comma-separated)."
+    ),
+    solvers: str = typer.Option("ipopt,adam", help="Optimisers: ipopt, adam (comma-separated)."),
+    seed: int = typer.Option(0, min=0, help="Problem seed."),
+    first: int = typer.Option(0, min=0, help="Run problems first … n − 1 only (split a run)."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
+    out: Path = typer.Option(Path("results/table2.md"), help="Markdown output (+ .json)."),
+    update: bool = typer.Option(
+        False, help="Keep the rows of the earlier run at --out that this run does not redo."
+    ),
+) -> None:
+    """The paper's Table II: every collision model × optimiser on random reaching problems."""
+    from . import table2
+
+    check_output_path(out, (".md",), "--out")
+    check_output_path(out.with_suffix(".json"), (".json",), "--out")
+    chosen = {
+        name: [v.strip() for v in value.split(",") if v.strip()]
+        for name, value in (("settings", settings), ("methods", methods), ("solvers", solvers))
+    }
+    allowed = {"settings": table2.SETTINGS, "methods": table2.METHODS, "solvers": table2.SOLVERS}
+    for name, values in chosen.items():
+        bad = [v for v in values if v not in allowed[name]]
+        if bad or not values:
+            raise InputError(f"--{name}: expected some of {allowed[name]}, got {bad or values}")
+    if n < 1:
+        raise InputError(f"--n: expected ≥ 1, got {n}")
+    if first >= n:
+        raise InputError(f"--first: expected a problem index below --n {n}, got {first}")
+    set_threads(threads)
+    records, skipped = [], []
+    for setting in chosen["settings"]:
+        problems = table2.reaching_problems(setting, n, seed)[first:]
+        got, why = table2.run_setting(
+            setting,
+            problems,
+            chosen["methods"],
+            chosen["solvers"],
+            log=lambda m: typer.echo(m, err=True),
+            first=first,
+        )
+        records += got
+        skipped += why
+    command = (
+        f"gdnplan reproduce table2 --n {n} --settings {settings} --methods {methods} "
+        f"--solvers {solvers} --seed {seed} --first {first} --threads {threads}"
+        + (" --update" if update else "")
+    )
+    typer.echo(table2.write(records, skipped, command, out, update))
+
+
+@app.command("fetch")
+def fetch_command(
+    seed: int = typer.Option(0, min=0, help="Fetch layout: 0 canonical, others random storages."),
+    collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
+    weights: str = typer.Option(None, help=WEIGHTS_HELP),
+    animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
+    json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
+    view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
+) -> None:
+    """The UR5e fetch: approach, reach in, grasp, lift, bring the stick out, retreat.
+
+    Exit status: 0 when every stage is certified collision-free, 1 otherwise, 2 on bad input.
+    """
+    from .fetch import run_fetch
+
+    if animate is not None:
+        check_output_path(animate, (".gif",), "--animate")
+    set_threads(threads)
+    if view3d:  # fail before planning, not after
+        from .viz3d import require_meshcat
+
+        require_meshcat()
+    stages = run_fetch(seed, collision=collision, weights=weights)
+    ok = all(s.success for s in stages)
+    if json_output:
+        summary = {"seed": seed, "collision": collision, "success": ok}
+        summary["stages"] = [s.summary() for s in stages]
+        typer.echo(json.dumps(summary))
+    else:
+        for s in stages:
+            how = "planned" if s.planned else "scripted"
+            verdict = "certified" if s.success else f"FAILED ({s.detail})"
+            typer.echo(
+                f"{s.name:<10} {s.scene.robot.info['gripper']:<8} {how:<8} {verdict}; "
+                f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
+            )
+        total = sum(s.solve_time for s in stages)
+        verdict = "success" if ok else "FAILED"
+        typer.echo(f"fetch seed {seed} ({collision}): {verdict}, {total:.1f} s in all")
+    if animate is not None:
+        from .viz import animate_paths
+
+        title = f"fetch seed {seed}: {collision}"
+        animate_paths([(s.scene, s.q) for s in stages], animate, title=title)
+        if not json_output:
+            typer.echo(f"wrote {animate}")
+    if view3d:
+        from .viz3d import view_plan
+
+        view_plan([(s.scene, s.q) for s in stages])
+    if not ok:
+        raise typer.Exit(1)
+
+
+@app.command("generate")
+def generate_command(
+    env: str = typer.Option(..., help="Environment: a-e or ur5e."),
+    split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
+    n: int = typer.Option(None, min=1, help="Samples (default: the paper's 50 000 / 5 000)."),
+    seed: int = typer.Option(None, min=0, help="Override the split's seed."),
+    near: float = typer.Option(
+        0.0,
+        help="Fraction of samples drawn near contact: around the fetch task (ur5e), "
+        "|f| < 3 cm (a-e).",
+    ),
+    workers: int = typer.Option(None, min=1, help="Worker processes (default: all cores)."),
+    data: Path = typer.Option(None, help="Data root (default data/): <data>/<env>/<split>."),
+) -> None:
+    """Write a dataset of graphs and coal labels in resumable shards (finished shards are kept)."""
+    from .data import DATA_DIR, SPLITS, generate, split_dir
+
+    if split not in SPLITS:
+        raise InputError(f"--split: expected one of {sorted(SPLITS)}, got {split!r}")
+    split_seed, size = SPLITS[split]
+    target = check_output_dir(split_dir(env, split, data or DATA_DIR), "--data")
+    generate(
+        env, size if n is None else n, split_seed if seed is None else seed, target, workers, near
+    )
+    typer.echo(f"wrote {target}")
+
+
+@app.command("train")
+def train_command(
+    env: str = typer.Option(..., help="Environment: a-e or ur5e (its data must exist)."),
+    model: str = typer.Option("graphdistnet", help="graphdistnet or clearancenet."),
+    preset: str = typer.Option("smooth", help="GraphDistNet: smooth (planner) or faithful."),
+    name: str = typer.Option(None, help="Run name, runs/<env>-<name> (default: the preset)."),
+    set_: list[str] = typer.Option([], "--set", help="Config override key=json_value."),
+    n_train: int = typer.Option(
+        None, min=2, help="Use only the first n training samples (≥ 2: 10 % validate)."
+    ),
+    batch: int = typer.Option(256, min=1, help="Batch size."),
+    lr: float = typer.Option(1e-3, help="Adam learning rate (≥ 0; 0 keeps --init's weights)."),
+    epochs: int = typer.Option(200, min=1, help="Epoch cap."),
+    patience: int = typer.Option(10, min=1, help="Early stopping: epochs without improvement."),
+    time_budget: float = typer.Option(None, help="Seconds of training (> 0)."),
+    seed: int = typer.Option(0, min=0, help="Random seed."),
+    device: str = typer.Option("cpu", help="cpu or cuda."),
+    threads: int = typer.Option(1, help="torch threads."),
+    data: Path = typer.Option(None, help="Data root (default: data/)."),
+    out: Path = typer.Option(None, help="Weights path (default: weights/<env>.safetensors)."),
+    run_dir: Path = typer.Option(None, help="Checkpoints, loss curve (default runs/<env>-<name>)."),
+    compile: bool = typer.Option(False, "--compile", help="torch.compile the training step."),
+    init: str = typer.Option(
+        None,
+        help="Fine-tune from these GraphDistNet weights, a shipped name or a path (their "
+        "card's config; --set applies).",
+    ),
+    extra: list[Path] = typer.Option(
+        [], help="More training shards (a directory, e.g. from generate --near); repeatable."
+    ),
+) -> None:
+    """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
+    from .assets import weights_file
+    from .train import check_options
+
+    check_options(n_train, batch, lr, epochs, patience, time_budget, device)
+    init = None if init is None else weights_file(init)
+    if out is not None:
+        check_output_path(out, (".safetensors",), "--out")
+        check_output_path(out.with_suffix(".json"), (".json",), "--out")
+    if run_dir is not None:
+        check_output_dir(run_dir, "--run-dir")
+    if model == "clearancenet":
+        from .models.clearancenet import train_and_save
+
+        card = train_and_save(env, time_budget or 120.0, patience, out)
+        typer.echo(json.dumps({"env": env, **card["test"]}, indent=2))
+        return
+    if model != "graphdistnet":
+        raise InputError(f"--model: expected graphdistnet or clearancenet, got {model!r}")
+
+    from .data import DATA_DIR
+    from .models.graphdistnet import GraphDistNetConfig
+    from .train import PRESETS, train
+
+    if preset not in PRESETS:
+        raise InputError(f"--preset: expected one of {sorted(PRESETS)}, got {preset!r}")
+    try:
+        overrides = {k: json.loads(v) for k, v in (s.split("=", 1) for s in set_)}
+    except ValueError as e:
+        raise InputError(f"--set: expected key=json_value, got {set_}") from e
+    base = PRESETS[preset]().to_dict() if init is None else _card_config(init)
+    try:
+        config = GraphDistNetConfig.from_dict(base | overrides)
+    except (TypeError, ValueError) as e:
+        if isinstance(e, InputError):
+            raise InputError(f"--set: {e}") from e
+        raise InputError(f"--set: a value of the wrong type in {set_} ({e})") from e
+    set_threads(threads)
+    card = train(
+        env,
+        config,
+        name or preset,
+        n_train,
+        batch,
+        lr,
+        epochs,
+        patience,
+        time_budget,
+        seed,
+        device,
+        data_root=data or DATA_DIR,
+        out=out,
+        run_dir=run_dir,
+        compile=compile,
+        init=init,
+        extra=extra,
+    )
+    typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
+
+
+def _card_config(weights: Path) -> dict:
+    """The config of the JSON card beside ``weights`` (InputError when it is missing)."""
+    from .models.weights import read_card
+
+    config = read_card(weights, "--init").get("config")
+    if not isinstance(config, dict):
+        raise InputError(f"--init: the card of {weights} has no 'config' object")
+    return config
+
+
+FIELD_GRID_MAX = 1001  # 10⁶ configurations, minutes per model
+
+
+@app.command("field")
+def field_command(
+    env: str = typer.Option("a", help="A 2-DoF environment (a or b)."),
+    out: Path = typer.Option(Path("field.png"), help="Output PNG."),
+    grid: int = typer.Option(101, min=2, max=FIELD_GRID_MAX, help="Grid points per joint."),
+) -> None:
+    """The paper's Fig. 5: distance fields over (q1, q2) from coal, DiffCo and GraphDistNet."""
+    from .evaluate import fig5
+    from .viz import save_figure
+
+    if env not in ("a", "b"):
+        raise InputError(f"--env: expected a 2-DoF environment, a or b, got {env!r}")
+    check_output_path(out, FIGURE_SUFFIXES, "--out")
+    save_figure(fig5(env, grid), out)
+    typer.echo(f"wrote {out}")
+
+
+def run(args: list[str] | None = None) -> None:
+    """Run the app on ``args`` (default: the command line); exits with the status of the module
+    docstring, every error as one line on stderr."""
+    _DEBUG["on"] = False
+    try:
+        code = app(args=args, prog_name="gdnplan", standalone_mode=False)
+        if code == EXIT_INTERRUPTED:  # typer returns Ctrl-C in a command as exit code 130
+            typer.echo("error: interrupted", err=True)
+    except click_exceptions.NoArgsIsHelpError as e:
+        e.show()
+        code = EXIT_INPUT
+    except click_exceptions.UsageError as e:
+        hint = f"; see `{e.ctx.command_path} --help`" if e.ctx is not None else ""
+        code = _fail(e, one_line(e.format_message()) + hint, EXIT_INPUT)
+    except GdnplanError as e:
+        code = _fail(e, one_line(str(e)), EXIT_INPUT)
+    except (KeyboardInterrupt, typer.Abort) as e:
+        code = _fail(e, "interrupted", EXIT_INTERRUPTED)
+    except Exception as e:  # the last resort: a bug, never a traceback without --debug
+        why = f"{type(e).__name__}: {one_line(str(e))}" if str(e) else type(e).__name__
+        message = f"internal error ({why}); rerun with --debug for the traceback"
+        code = _fail(e, message, EXIT_INTERNAL)
+    sys.exit(code if isinstance(code, int) else 0)
+
+
+def _fail(e: BaseException, message: str, code: int) -> int:
+    """Print ``error: message`` (after the traceback with ``--debug``); returns ``code``."""
+    if _DEBUG["on"]:
+        traceback.print_exception(e)
+    typer.echo(f"error: {message}", err=True)
+    return code
+
+
+def one_line(text: str, limit: int = 400) -> str:
+    """``text`` on one line (whitespace runs become one space), at most ``limit`` characters."""
+    flat = " ".join(text.split())
+    return flat if len(flat) <= limit else flat[: limit - 1] + "…"
+
+
+def main() -> None:
+    """Console entry point."""
+    run()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,653 @@
+"""Table I metrics (paper §V-A): MAE with Welch's t-test, ROC AUC, ACD and batch timing.
+
+All metrics are pure functions of arrays; :func:`evaluate_model` applies them to one model on
+the held-out test split of an environment (``data/<env>/test``, seed 1, see :mod:`gdnplan.data`),
+so every method sees the same configurations and obstacle sets.
+
+Definitions (coal is the ground truth f):
+
+* MAE = mean_i |d̂_i − f_i| (m), also reported as a fraction of the robot's reach.
+* Welch's t-test between two absolute-error samples e₁, e₂ (unequal variances):
+  t = (ē₁ − ē₂) / √(s₁²/n₁ + s₂²/n₂),  ν = (s₁²/n₁ + s₂²/n₂)² / Σ_k (s_k²/n_k)² / (n_k − 1),
+  p = 2 · P(T_ν > |t|).
+* AUC of the classification "collision ⇔ f ≤ margin": positives are coal collisions, the
+  score is −d̂ (smaller predicted distance ⇒ more likely in collision); computed by the rank
+  (Mann–Whitney) formula AUC = (R₊ − n₊(n₊ + 1)/2) / (n₊ n₋) with mid-ranks for ties.
+* ACD = mean_i (1 − cos(∇d̂_i, ∇f_i)) over configurations where coal's gradient is non-zero;
+  a zero model gradient counts as cos = 0 (distance 1).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+from scipy import stats
+
+from .assets import WEIGHTS_DIR
+from .data import DATA_DIR, SPLITS, Dataset, load, make_shard, split_dir
+from .distance import signed_distance, signed_distance_and_grad
+from .errors import InputError
+from .models import DistanceModel
+
+DEFAULT_MARGIN = 0.0  # m: collision ⇔ f ≤ margin
+
+
+# -------------------------------------------------------------------- metrics (pure)
+def mean_absolute_error(pred: np.ndarray, true: np.ndarray) -> float:
+    """MAE (m) of predictions (B,) against ground truth (B,)."""
+    pred, true = np.asarray(pred, float), np.asarray(true, float)
+    if pred.shape != true.shape or pred.ndim != 1 or len(pred) == 0:
+        raise InputError(
+            f"pred/true: expected equal non-empty (B,) shapes, got {pred.shape}, {true.shape}"
+        )
+    return float(np.mean(np.abs(pred - true)))
+
+
+def welch_p_value(a: np.ndarray, b: np.ndarray) -> float:
+    """Two-sided p-value of Welch's t-test (unequal variances) between samples a and b."""
+    return float(
+        stats.ttest_ind(np.asarray(a, float), np.asarray(b, float), equal_var=False).pvalue
+    )
+
+
+def roc_auc(score: np.ndarray, positive: np.ndarray) -> float:
+    """Area under the ROC curve by the rank formula (ties get mid-ranks, i.e. count ½).
+
+    Args:
+        score: (B,) larger = more likely positive.
+        positive: (B,) bool labels.
+
+    Returns:
+        AUC in [0, 1]; NaN when one class is empty.
+    """
+    score, positive = np.asarray(score, float), np.asarray(positive, bool)
+    n_pos, n_neg = int(positive.sum()), int((~positive).sum())
+    if n_pos == 0 or n_neg == 0:
+        return float("nan")
+    ranks = stats.rankdata(score)  # average ranks for ties
+    return float((ranks[positive].sum() - n_pos * (n_pos + 1) / 2) / (n_pos * n_neg))
+
+
+def roc_curve(score: np.ndarray, positive: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """ROC points (false-positive rate, true-positive rate), each (K,), from (0,0) to (1,1).
+
+    One point per distinct threshold (tied scores move both rates at once), so the trapezoid
+    area under the curve equals :func:`roc_auc`.
+    """
+    score, positive = np.asarray(score, float), np.asarray(positive, bool)
+    order = np.argsort(-score, kind="stable")
+    s, y = score[order], positive[order]
+    last = np.r_[np.flatnonzero(np.diff(s) != 0), len(s) - 1]  # end of each tie group
+    tp = np.r_[0, np.cumsum(y)[last]]
+    fp = np.r_[0, np.cumsum(~y)[last]]
+    return fp / max(fp[-1], 1), tp / max(tp[-1], 1)
+
+
+def cosine_distances(g_model: np.ndarray, g_true: np.ndarray) -> np.ndarray:
+    """Per-row 1 − cos(g_model, g_true) for (B, n) arrays; a zero row has cos = 0."""
+    a, b = np.asarray(g_model, float), np.asarray(g_true, float)
+    na, nb = np.linalg.norm(a, axis=1), np.linalg.norm(b, axis=1)
+    dot = np.einsum("ij,ij->i", a, b)
+    cos = np.divide(dot, na * nb, out=np.zeros_like(dot), where=(na > 0) & (nb > 0))
+    return 1.0 - cos
+
+
+def used_cosine_distances(g_model: np.ndarray, g_true: np.ndarray) -> np.ndarray:
+    """1 − cos(ĝ, g) (n_used,) over the rows where coal's gradient g is non-zero."""
+    used = np.linalg.norm(np.asarray(g_true, float), axis=1) > 0
+    return cosine_distances(g_model[used], g_true[used])
+
+
+def timed(fn: Callable[[], Any], repeats: int = 1) -> tuple[Any, float]:
+    """Run ``fn`` ``repeats`` times; return its last result and the fastest wall time (s)."""
+    best, out = np.inf, None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return out, float(best)
+
+
+# -------------------------------------------------------------------- test sets
+def test_set(env: str, n: int = SPLITS["test"][1], root: Path | str = DATA_DIR) -> Dataset:
+    """The first n samples of the held-out split of ``env`` (seed 1).
+
+    Reads ``data/<env>/test`` when it holds at least n samples, otherwise labels them here with
+    :func:`gdnplan.data.make_shard` (the same samples, as the split is a pure function).
+    """
+    path = split_dir(env, "test", root)
+    if path.is_dir() and any(path.glob("shard_*.npz")):
+        ds = load(path, n)
+        if len(ds) >= n:
+            return ds
+    return make_shard(env, SPLITS["test"][0], 0, n)
+
+
+def scene_groups(ds: Dataset) -> list[np.ndarray]:
+    """Indices of samples sharing one obstacle set (one group for a/c, one per sample for b/d/e)."""
+    key = np.ascontiguousarray(
+        np.concatenate([ds.obstacles.reshape(len(ds), -1), ds.sizes.astype(float)], 1)
+    )
+    _, inverse = np.unique(key, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    return [np.flatnonzero(inverse == g) for g in range(inverse.max() + 1)]
+
+
+@runtime_checkable
+class DatasetModel(Protocol):
+    """A model that predicts a whole dataset at once (each sample with its own obstacles)."""
+
+    def predict_dataset(self, ds: Dataset, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        """((B,), (B, dof) or None) predictions for every sample of ``ds``."""
+        ...
+
+
+def predict(model: DistanceModel, ds: Dataset, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    """Predictions ((B,), (B, dof) or None) of any model on a dataset.
+
+    Uses ``model.predict_dataset`` when the model has it; otherwise calls the model once per
+    obstacle set (:func:`scene_groups`).
+    """
+    if isinstance(model, DatasetModel):
+        return model.predict_dataset(ds, grad)
+    d = np.empty(len(ds))
+    g = np.empty(ds.q.shape) if grad else None
+    for idx in scene_groups(ds):
+        scene = ds.scene(int(idx[0]))
+        if grad:
+            d[idx], g[idx] = model.distance_and_grad(scene, ds.q[idx])
+        else:
+            d[idx] = model.distance(scene, ds.q[idx])
+    return d, g
+
+
+def coal_predict(ds: Dataset, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+    """coal on a dataset, one call per obstacle set (what the coal timing measures)."""
+    d = np.empty(len(ds))
+    g = np.empty(ds.q.shape) if grad else None
+    for idx in scene_groups(ds):
+        scene = ds.scene(int(idx[0]))
+        if grad:
+            d[idx], g[idx] = signed_distance_and_grad(scene, ds.q[idx])
+        else:
+            d[idx] = signed_distance(scene, ds.q[idx])
+    return d, g
+
+
+# -------------------------------------------------------------------- one model
+@dataclass(frozen=True)
+class Result:
+    """One method on one environment.
+
+    Attributes:
+        method: display name.
+        env: environment.
+        n: samples in the timed batch and the AUC / MAE.
+        seconds: wall time of the distance batch (s).
+        mae: MAE (m), None for score models (DiffCo).
+        mae_reach: MAE / reach of the robot, None for score models.
+        auc: ROC AUC of f ≤ margin.
+        acd: average cosine distance of ∂/∂q, over ``n_grad`` configurations.
+        acd_se: its standard error s / √n_grad (a tail of near-opposite gradients dominates it).
+        n_grad: configurations in the ACD.
+        abs_error: (n,) |d̂ − f| (for Welch's test), None for score models.
+        score: (n,) the model's output d̂ (for ROC curves and scatter plots).
+    """
+
+    method: str
+    env: str
+    n: int
+    seconds: float
+    mae: float | None
+    mae_reach: float | None
+    auc: float
+    acd: float | None
+    acd_se: float | None
+    n_grad: int
+    abs_error: np.ndarray | None
+    score: np.ndarray
+
+
+def evaluate_predictions(
+    method: str,
+    ds: Dataset,
+    d_hat: np.ndarray,
+    g_hat: np.ndarray | None,
+    seconds: float,
+    is_distance: bool,
+    reach: float,
+    margin: float = DEFAULT_MARGIN,
+) -> Result:
+    """Metrics of predictions d̂ (B,) and gradients (n_grad, dof) (first rows of ``ds``)."""
+    err = np.abs(d_hat - ds.d) if is_distance else None
+    mae = mean_absolute_error(d_hat, ds.d) if is_distance else None
+    cd = None if g_hat is None else used_cosine_distances(g_hat, ds.grad[: len(g_hat)])
+    return Result(
+        method=method,
+        env=ds.env,
+        n=len(ds),
+        seconds=seconds,
+        mae=mae,
+        mae_reach=None if mae is None else mae / reach,
+        auc=roc_auc(-d_hat, ds.d <= margin),
+        acd=None if cd is None else float(np.mean(cd)),
+        acd_se=None if cd is None else float(stats.sem(cd)),
+        n_grad=0 if cd is None else len(cd),
+        abs_error=err,
+        score=d_hat,
+    )
+
+
+def evaluate_model(
+    model: DistanceModel,
+    env: str,
+    n: int = 5000,
+    n_grad: int = 5000,
+    ds: Dataset | None = None,
+    margin: float = DEFAULT_MARGIN,
+    repeats: int = 3,
+) -> Result:
+    """Time, MAE, AUC and ACD of one model on the first n test samples of ``env``.
+
+    The time is the fastest of ``repeats`` wall times of ``distance`` over the whole batch (per
+    obstacle set where the model has no ``predict_dataset``); gradients are taken on the first
+    ``n_grad`` samples.
+    Models with ``is_distance = False`` (scores, e.g. DiffCo) get no MAE.
+    """
+    ds = test_set(env, n) if ds is None else ds.subset(slice(0, n))
+    (d_hat, _), seconds = timed(lambda: predict(model, ds, grad=False), repeats)
+    _, g_hat = predict(model, ds.subset(slice(0, min(n_grad, len(ds)))), grad=True)
+    reach = ds.scene(0).robot.reach
+    return evaluate_predictions(
+        getattr(model, "name", type(model).__name__),
+        ds,
+        d_hat,
+        g_hat,
+        seconds,
+        bool(getattr(model, "is_distance", True)),
+        reach,
+        margin,
+    )
+
+
+# -------------------------------------------------------------------- Table I
+ENVS = ("a", "b", "c", "d", "e")
+DIFFCO_SOURCE = {"b": "a", "d": "c"}  # random env -> fixed env DiffCo is trained on (paper)
+
+# Paper Table I: (time s, MAE, AUC, ACD); None where the paper has "-" or N/A.
+PAPER: dict[str, dict[str, tuple]] = {
+    "a": {
+        "coal": (1.0653, None, None, None),
+        "DiffCo": (0.0048, None, 1.0000, 0.3575),
+        "ClearanceNet": (0.0009, 0.0082, 1.0000, 0.0255),
+        "GraphDistNet": (0.0115, 0.0031, 1.0000, 0.0054),
+    },
+    "b": {
+        "coal": (1.1822, None, None, None),
+        "DiffCo (w/o AL)": (0.0054, None, 0.5031, 1.0270),
+        "DiffCo (w/ AL)": (2058.2, None, 0.9948, 0.4221),
+        "ClearanceNet": (0.0009, 0.1732, 0.9986, 0.2853),
+        "GraphDistNet": (0.0115, 0.0390, 0.9999, 0.1748),
+    },
+    "c": {
+        "coal": (3.1573, None, None, None),
+        "DiffCo": (0.0740, None, 0.9843, 0.3202),
+        "ClearanceNet": (0.0012, 0.2360, 0.9111, 0.5933),
+        "GraphDistNet": (0.0574, 0.0253, 0.9990, 0.1458),
+    },
+    "d": {
+        "coal": (4.4467, None, None, None),
+        "DiffCo (w/o AL)": (0.0742, None, 0.5239, 0.9450),
+        "DiffCo (w/ AL)": (75129.5, None, 0.9798, 0.3968),
+        "ClearanceNet": (0.0012, 0.7725, 0.5691, 0.9491),
+        "GraphDistNet": (0.0546, 0.1614, 0.9842, 0.4152),
+    },
+    "e": {
+        "coal": (6.8432, None, None, None),
+        "DiffCo (w/o AL)": (0.0350, None, 0.5200, 0.9612),
+        "DiffCo (w/ AL)": (None, None, None, None),  # out of memory in the paper
+        "ClearanceNet": (0.0011, 0.7479, 0.8882, 0.9767),
+        "GraphDistNet": (0.1251, 0.2446, 0.9925, 0.8421),
+    },
+}
+PAPER_P = {"a": 6e-20, "b": 2e-12, "c": 6e-60, "d": 1e-10, "e": 3e-2}
+
+
+@dataclass(frozen=True)
+class TableSettings:
+    """Sizes of one Table I run.
+
+    Attributes:
+        n: held-out samples per environment (time, MAE, AUC).
+        n_grad: samples for the ACD.
+        diffco_train: DiffCo training configurations (2-DoF, 7-DoF).
+        al_scenes: test scenes DiffCo adapts to (active learning), per random environment.
+        al_queries: configurations evaluated in each adapted scene.
+        al_explore: uniform samples per active-learning update (besides 2 per support point).
+    """
+
+    n: int = 5000
+    n_grad: int = 5000
+    diffco_train: tuple[int, int] = (3000, 5000)
+    al_scenes: int = 10
+    al_queries: int = 200
+    al_explore: int = 2000
+
+    @classmethod
+    def fast(cls) -> TableSettings:
+        return cls(
+            n=200, n_grad=100, diffco_train=(400, 600), al_scenes=1, al_queries=100, al_explore=300
+        )
+
+
+class BatchedGraphDistNet:
+    """GraphDistNet with :meth:`predict_dataset`: one batched pass over samples with their own
+    obstacle graphs (graph construction included), via :mod:`gdnplan.train`'s tensors."""
+
+    name = "GraphDistNet"
+    is_distance = True
+
+    def __init__(self, model):
+        self.model = model
+
+    def distance(self, scene, q: np.ndarray) -> np.ndarray:
+        return self.model.distance(scene, q)
+
+    def distance_and_grad(self, scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.model.distance_and_grad(scene, q)
+
+    def predict_dataset(self, ds: Dataset, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        from .train import predict as predict_net
+        from .train import tensors
+
+        return predict_net(self.model.net, tensors(ds, self.model.net.config), grad=grad)
+
+
+def load_graphdistnet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
+    """GraphDistNet from ``<weights_dir>/<env>.safetensors`` when it exists, else None."""
+    path = Path(weights_dir) / f"{env}.safetensors"
+    if not path.exists():
+        return None
+    from .models import load_model
+
+    return BatchedGraphDistNet(load_model(path))
+
+
+def load_clearancenet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
+    """ClearanceNet from ``<weights_dir>/clearancenet_<env>.safetensors``, None if missing."""
+    from .models.clearancenet import load as load_cn
+
+    path = Path(weights_dir) / f"clearancenet_{env}.safetensors"
+    return load_cn(path) if path.exists() else None
+
+
+def diffco_rows(env: str, ds: Dataset, s: TableSettings) -> list[Result]:
+    """DiffCo on ``env``: the score for time and AUC, the fitted surrogate for the ACD.
+
+    Fixed environments (a, c) train on their own scene. Random ones (b, d, e) use a model
+    trained on a (b), c (d) or one e scene (e) as is ("w/o AL") and, on the scenes of the first
+    ``al_scenes`` test samples, after active learning ("w/ AL"); the latter's AUC and ACD pool
+    ``al_queries`` uniform configurations per adapted scene, and its time is the mean
+    adaptation time per scene × n (the paper adapts to each test scene).
+    """
+    from .models.diffco import DiffCo
+    from .scene import make_scene
+
+    source = make_scene(DIFFCO_SOURCE.get(env, env), seed=0)
+    n_train = s.diffco_train[0 if source.robot.dof == 2 else 1]
+    base = DiffCo.train(source, n=n_train, seed=0)
+    reach = source.robot.reach
+    grad_ds = ds.subset(slice(0, s.n_grad))
+    (d_hat, _), seconds = timed(lambda: predict(base, ds, grad=False), repeats=3)
+    _, g_hat = predict(base.fitted(), grad_ds, grad=True)
+    label = "DiffCo" if env in ("a", "c") else "DiffCo (w/o AL)"
+    rows = [evaluate_predictions(label, ds, d_hat, g_hat, seconds, False, reach)]
+    if env in ("a", "c"):
+        return rows
+    scores, grads, d_true, g_true, qs, adapt_time = [], [], [], [], [], 0.0
+    for i in range(min(s.al_scenes, len(ds))):
+        scene = ds.scene(i)
+        adapted, t = timed(
+            lambda scene=scene, i=i: base.adapt(scene, n_explore=s.al_explore, seed=i)
+        )
+        adapt_time += t
+        q = scene.robot.sample(s.al_queries, seed=[7, i])
+        f, gf = signed_distance_and_grad(scene, q)
+        scores.append(adapted.distance(scene, q))
+        grads.append(adapted.fitted().distance_and_grad(scene, q)[1])
+        d_true.append(f)
+        g_true.append(gf)
+        qs.append(q)
+    pooled = Dataset(
+        env,
+        np.concatenate(qs),
+        np.zeros((0, 0, 2)),
+        np.zeros((0, 0, 0, 2)),
+        np.zeros((0, 0), np.int32),
+        np.concatenate(d_true),
+        np.concatenate(g_true),
+        np.zeros(0, np.int64),
+    )
+    per_scene = adapt_time / max(min(s.al_scenes, len(ds)), 1)
+    rows.append(
+        evaluate_predictions(
+            "DiffCo (w/ AL)",
+            pooled,
+            np.concatenate(scores),
+            np.concatenate(grads),
+            per_scene * len(ds),
+            False,
+            reach,
+        )
+    )
+    return rows
+
+
+def table1_env(
+    env: str, s: TableSettings, weights_dir: Path = WEIGHTS_DIR, used: dict | None = None
+) -> tuple[list[Result], float | None]:
+    """All methods on one environment, and Welch's p of GraphDistNet vs ClearanceNet errors."""
+    ds = test_set(env, s.n)
+    (_, _), coal_s = timed(lambda: coal_predict(ds, grad=False))
+    rows = [
+        Result("coal", env, len(ds), coal_s, None, None, float("nan"), None, None, 0, None, ds.d)
+    ]
+    rows += diffco_rows(env, ds, s)
+    learned = {}
+    files = {
+        "ClearanceNet": f"clearancenet_{env}.safetensors",
+        "GraphDistNet": f"{env}.safetensors",
+    }
+    for name, loader in (("ClearanceNet", load_clearancenet), ("GraphDistNet", load_graphdistnet)):
+        if used is not None and (Path(weights_dir) / files[name]).exists():
+            used[files[name]] = sha256_prefix(Path(weights_dir) / files[name])
+        model = loader(env, weights_dir)
+        if model is not None:
+            learned[name] = evaluate_model(model, env, s.n, s.n_grad, ds=ds)
+            rows.append(replace(learned[name], method=name))
+    p = None
+    if len(learned) == 2:
+        p = welch_p_value(learned["GraphDistNet"].abs_error, learned["ClearanceNet"].abs_error)
+    return rows, p
+
+
+NOTES = """
+Notes (how each number is made; `paper` columns are the paper's Table I):
+
+- Samples: the first n of `data/<env>/test` (seed 1, one obstacle set per sample in b, d, e);
+  the same samples for every method. MAE, AUC and time over n; ACD over the first n_grad
+  ([n] in the ACD column, all n by default; the paper sampled 100 gradients), ± its standard
+  error s/√n, coal's exact gradient as reference, rows with a zero coal gradient left out.
+  AUC: positives are coal's f ≤ 0, the score is −d̂.
+- Time: fastest of 3 wall times of the distance batch on this shared 2-core CPU (coal: one run,
+  one call per obstacle set including building its coal shapes; learned models: one batched
+  pass on one torch thread, GraphDistNet including graph construction). Other jobs shared the
+  CPU, so times vary between runs by up to ~10×. The paper timed a GPU for the networks.
+- MAE [/reach]: metres, and as a fraction of the arm's reach (1.2 m planar2, 2.1 m planar7).
+  p (GraphDistNet row): two-sided Welch's t-test between GraphDistNet's and ClearanceNet's
+  absolute errors, with the method whose MAE is lower.
+- DiffCo: FK-kernel perceptron (Fastron updates) trained on 3000 (2-DoF) or 5000 (7-DoF)
+  coal-labelled configurations of a (for a, b), c (for c, d) or one random e scene (for e).
+  AUC and time use the perceptron score; ACD uses the fitted surrogate (kernel ridge regression
+  of coal's f over the labelled configurations), DiffCo's smooth score for optimisation.
+  w/ AL: active learning on the scenes of the first 10 test samples (relabel support points,
+  2 Gaussian perturbations each, 2000 uniform samples, continue the perceptron); AUC and ACD
+  pool 200 uniform configurations per adapted scene; time = mean adaptation time per scene
+  × n (extrapolated, as the paper adapts to every test scene). The paper's DiffCo w/ AL ran out
+  of memory in e, hence no paper numbers there.
+- ClearanceNet: MLP 3×256 ReLU on [q/π, obstacle poses (centre, cos 4θ, sin 4θ) or padded
+  α-shape vertices], dropout 0.5 for d and e, Adam on data/<env>/train (weights card: data,
+  epochs, seconds); a 120 s training budget per environment on this CPU.
+"""
+
+
+def _num(v: float | None, fmt: str) -> str:
+    return "–" if v is None or (isinstance(v, float) and np.isnan(v)) else format(v, fmt)
+
+
+def _p_text(p: float | None, rows: list[Result]) -> str:
+    """Welch's p with the side whose MAE is lower (the test itself is two-sided)."""
+    if p is None:
+        return "–"
+    mae = {r.method: r.mae for r in rows}
+    lower = "GDN" if mae["GraphDistNet"] < mae["ClearanceNet"] else "CN"
+    return f"{'< 1e-300' if p == 0 else format(p, '.1e')} ({lower} lower)"
+
+
+def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> str:
+    """Markdown of Table I: ours beside the paper's numbers (paper in the ``paper`` columns)."""
+    head = (
+        "| env | method | time (s) | paper | MAE (m) [/reach] | paper | p (GDN vs CN) | paper "
+        "| AUC | paper | ACD [n] | paper |"
+    )
+    lines = [head, "|" + "---|" * 12]
+    for env, (rows, p) in results.items():
+        for r in rows:
+            pt, pm, pa, pc = PAPER[env].get(r.method, (None,) * 4)
+            learned = r.method == "GraphDistNet"
+            p_text = _p_text(p, rows) if learned else ""
+            mae = (
+                "N/A"
+                if r.method.startswith("DiffCo")
+                else ("–" if r.mae is None else f"{r.mae:.4f} [{r.mae_reach:.4f}]")
+            )
+            lines.append(
+                f"| {env} | {r.method} | {r.seconds:.4g} | {_num(pt, '.5g')} | {mae} "
+                f"| {_num(pm, '.4f')} | {p_text} "
+                f"| {_num(PAPER_P[env], '.0e') if learned else ''} "
+                f"| {_num(r.auc, '.4f')} | {_num(pa, '.4f')} "
+                f"| {_num(r.acd, '.4f')}{_se_text(r)} "
+                f"| {_num(pc, '.4f')} |"
+            )
+    return "\n".join(lines) + "\n" + NOTES
+
+
+def _se_text(r: Result) -> str:
+    """' ± SE [n]' after an ACD, '' for rows without one."""
+    return "" if r.acd is None else f" ± {r.acd_se:.4f} [{r.n_grad}]"
+
+
+def table1(
+    envs: tuple[str, ...] = ENVS, fast: bool = False, log=print, weights_dir: Path = WEIGHTS_DIR
+):
+    """Run Table I: ({env: (rows, p)}, missing weights, {weights file: sha256 prefix at load}).
+
+    ``fast`` uses :meth:`TableSettings.fast`.
+    """
+    import torch
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)  # stable timings on a shared CPU; every network gets one thread
+    s = TableSettings.fast() if fast else TableSettings()
+    out, used = {}, {}
+    try:
+        for env in envs:
+            out[env] = table1_env(env, s, weights_dir, used)
+            log(f"env {env}: " + ", ".join(r.method for r in out[env][0]))
+    finally:
+        torch.set_num_threads(threads)
+    missing = [
+        f"{name} {env}"
+        for env in envs
+        for name, path in (("ClearanceNet", f"clearancenet_{env}"), ("GraphDistNet", env))
+        if not (Path(weights_dir) / f"{path}.safetensors").exists()
+    ]
+    return out, missing, used
+
+
+def detour_path(
+    scene,
+    start: np.ndarray,
+    goal: np.ndarray,
+    clearance: float = 0.05,
+    steps: int = 200,
+    waypoints: int = 60,
+) -> np.ndarray:
+    """A joint path (T, dof) from start to goal pushed out of collision along coal's gradient.
+
+    Starts from the straight line and moves every waypoint closer than ``clearance`` (m) by
+    0.05 rad along ∂f/∂q, then re-spaces the path evenly, ``steps`` times (for Fig. 5 only).
+    """
+    q = np.linspace(start, goal, waypoints)
+    for _ in range(steps):
+        d, g = signed_distance_and_grad(scene, q[1:-1])
+        push = (d < clearance)[:, None] * g / np.maximum(np.linalg.norm(g, axis=1), 1e-9)[:, None]
+        q[1:-1] += 0.05 * push
+        arc = np.r_[0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
+        t = np.linspace(0, arc[-1], waypoints)
+        q = np.stack([np.interp(t, arc, q[:, j]) for j in range(q.shape[1])], 1)
+    return q
+
+
+def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000):
+    """The paper's Fig. 5 for a 2-DoF environment: coal, DiffCo (score) and GraphDistNet fields.
+
+    Returns the matplotlib Figure; GraphDistNet is left out when its weights are missing.
+    """
+    from .models import CoalModel
+    from .models.diffco import DiffCo
+    from .scene import make_scene
+    from .viz import distance_field, field_figure
+
+    scene = make_scene(env, seed=0)
+    fields = {"coal f (m)": distance_field(CoalModel(), scene, grid)}
+    fields["DiffCo score −s"] = distance_field(DiffCo.train(scene, n=diffco_train), scene, grid)
+    gdn = load_graphdistnet(env)
+    if gdn is not None:
+        fields["GraphDistNet d̂ (m)"] = distance_field(gdn, scene, grid)
+    path = detour_path(scene, np.array([1.3, 1.5]), np.array([1.3, -2.6]))
+    return field_figure(scene, fields, path)
+
+
+def table1_figures(results: dict[str, tuple[list[Result], float | None]], out_dir: Path) -> list:
+    """ROC curves and predicted-vs-true scatter plots of a Table I run, written as PNGs."""
+    from .viz import roc_figure, save_figure, scatter_figure
+
+    curves, points = {}, {}
+    for env, (rows, _) in results.items():
+        truth = next(r.score for r in rows if r.method == "coal")
+        curves[env] = {
+            r.method: (*roc_curve(-r.score, truth <= DEFAULT_MARGIN), r.auc)
+            for r in rows
+            if r.method != "coal" and "w/ AL" not in r.method
+        }
+        points[env] = {
+            r.method: (truth[:1000], r.score[:1000]) for r in rows if r.abs_error is not None
+        }
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = [out_dir / "table1_roc.png", out_dir / "table1_scatter.png"]
+    save_figure(roc_figure(curves), paths[0])
+    save_figure(scatter_figure(points), paths[1])
+    return paths
+
+
+def sha256_prefix(path: Path) -> str:
+    """First 10 hex digits of a file's SHA-256."""
+    import hashlib
+
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()[:10]

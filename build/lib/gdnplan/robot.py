@@ -1,0 +1,573 @@
+"""Robots: a Pinocchio model reduced to its planning plane, one convex 2-D polygon per link part.
+
+Every robot gdnplan plans for moves in a plane: all planning joints are revolute with axes along
+the plane normal ``n``. A point ``p`` rigidly attached to body ``b`` (the body after the first
+``b`` planning joints) therefore moves as the composition of plane rotations
+
+    p(q) = T_1(q_1) ∘ T_2(q_2) ∘ … ∘ T_b(q_b) (p⁰),    T_j(θ) = rotation by s_j θ about o_j⁰,
+
+where ``p⁰`` and ``o_j⁰`` are the point and joint ``j`` at ``q = 0`` (2-D plane coordinates) and
+``s_j = ±1`` is the sign of the joint axis along ``n``. Its Jacobian column is
+
+    ∂p/∂q_j = s_j ẑ × (p − o_j(q))   for j ≤ b,   0 otherwise.
+
+:class:`PlanarChain` evaluates both for a batch with a handful of numpy operations; Pinocchio
+stays the reference (``Robot.node_positions_pinocchio``) and a test proves the two equal.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .assets import robot_urdf
+from .errors import InputError, UnknownNameError
+from .geometry import convex_hull, simplify_convex
+
+
+def rot2(theta: np.ndarray) -> np.ndarray:
+    """Rotation matrices of angles ``theta`` (...,) -> (..., 2, 2)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+def cross_z(v: np.ndarray) -> np.ndarray:
+    """ẑ × v for planar vectors v (..., 2)."""
+    return np.stack([-v[..., 1], v[..., 0]], -1)
+
+
+@dataclass(frozen=True)
+class PlanarChain:
+    """Serial chain of revolute joints that all rotate about the plane normal.
+
+    Attributes:
+        joint_origins: (dof, 2) joint positions at q = 0, plane coordinates (m).
+        joint_signs: (dof,) +1 when the joint axis is along the plane normal, -1 when opposite.
+    """
+
+    joint_origins: np.ndarray
+    joint_signs: np.ndarray
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_signs)
+
+    def transform(self, points0: np.ndarray, body: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """World positions at q of points attached to bodies.
+
+        Args:
+            points0: (N, 2) positions at q = 0.
+            body: (N,) number of planning joints upstream of each point (0 = fixed base).
+            q: (B, dof) joint angles (rad).
+
+        Returns:
+            (B, N, 2) positions (m).
+        """
+        p = np.broadcast_to(points0, (q.shape[0], *points0.shape)).copy()
+        for j in range(self.dof - 1, -1, -1):  # tip joint first: p = T_1 ∘ … ∘ T_b (p⁰)
+            moved = body > j
+            if not moved.any():
+                continue
+            o = self.joint_origins[j]
+            r = rot2(self.joint_signs[j] * q[:, j])  # (B, 2, 2)
+            p[:, moved] = o + np.einsum("bij,bnj->bni", r, p[:, moved] - o)
+        return p
+
+    def joint_positions(self, q: np.ndarray) -> np.ndarray:
+        """(B, dof, 2) positions of the joints at q (joint j sits on body j)."""
+        return self.transform(self.joint_origins, np.arange(self.dof), q)
+
+    def jacobian(self, points: np.ndarray, body: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """Jacobians ∂p/∂q of attached points already placed at q.
+
+        Args:
+            points: (B, N, 2) positions at q (from :meth:`transform`).
+            body: (N,) body index of each point.
+            q: (B, dof) joint angles.
+
+        Returns:
+            (B, N, 2, dof), column j = s_j ẑ × (p − o_j(q)) where joint j is upstream.
+        """
+        joints = self.joint_positions(q)  # (B, dof, 2)
+        lever = points[:, :, None, :] - joints[:, None, :, :]  # (B, N, dof, 2)
+        jac = cross_z(lever) * self.joint_signs[:, None]
+        jac = jac * (body[:, None] > np.arange(self.dof))[None, :, :, None]
+        return np.moveaxis(jac, 2, 3)
+
+
+@dataclass(frozen=True)
+class LinkPolygon:
+    """A convex polygon rigidly attached to one body of the chain.
+
+    Attributes:
+        name: e.g. ``"link3"`` or ``"forearm_link_0"``.
+        body: planning joints upstream (0 = fixed base, dof = last body).
+        frame: Pinocchio frame id the polygon is attached to.
+        vertices0: (m, 2) CCW vertices in plane coordinates at q = 0 (m).
+        vertices_frame: (m, 3) the same points in the frame's coordinates (Pinocchio reference).
+    """
+
+    name: str
+    body: int
+    frame: int
+    vertices0: np.ndarray
+    vertices_frame: np.ndarray
+
+
+@dataclass(frozen=True)
+class Plane:
+    """The planning plane: 2-D coordinates u = axes · (x − origin) of a world point x (3,)."""
+
+    origin: np.ndarray
+    axes: np.ndarray  # (2, 3), orthonormal rows
+
+    @property
+    def normal(self) -> np.ndarray:
+        return np.cross(self.axes[0], self.axes[1])
+
+    def project(self, x: np.ndarray) -> np.ndarray:
+        """World points (..., 3) -> plane coordinates (..., 2)."""
+        return (x - self.origin) @ self.axes.T
+
+    def lift(self, u: np.ndarray) -> np.ndarray:
+        """Plane coordinates (..., 2) -> world points (..., 3) on the plane."""
+        return self.origin + u @ self.axes
+
+
+@dataclass(frozen=True, eq=False)
+class Robot:
+    """A planar-moving robot: Pinocchio model of its planning joints plus link polygons.
+
+    Attributes:
+        name: registry name (``"planar2"``, ``"planar7"``, ``"ur5e"``, ``"ur5"``).
+        model: Pinocchio model reduced to the planning joints (a serial chain).
+        plane: the plane the robot moves in.
+        polygons: convex link polygons (the robot graph's nodes are their vertices).
+        lower, upper: (dof,) joint limits (rad).
+        base_radius: obstacles are never placed within this radius of joint 1 (m).
+        info: free-form metadata (gripper state, stick size, source URDF).
+    """
+
+    name: str
+    model: pin.Model
+    plane: Plane
+    polygons: tuple[LinkPolygon, ...]
+    lower: np.ndarray
+    upper: np.ndarray
+    base_radius: float = 0.15
+    info: dict = field(default_factory=dict)
+
+    # ---------------------------------------------------------------- structure
+    @property
+    def dof(self) -> int:
+        return self.model.nq
+
+    @property
+    def joint_names(self) -> list[str]:
+        return list(self.model.names)[1:]
+
+    @property
+    def n_links(self) -> int:
+        """Number of link polygons (the per-link distance has this many columns)."""
+        return len(self.polygons)
+
+    @cached_property
+    def chain(self) -> PlanarChain:
+        data = self.model.createData()
+        pin.forwardKinematics(self.model, data, np.zeros(self.dof))
+        origins = np.array(
+            [self.plane.project(data.oMi[j].translation) for j in range(1, self.dof + 1)]
+        )
+        signs = []
+        for j in range(1, self.dof + 1):
+            axis = data.oMi[j].rotation @ _joint_axis(self.model, j)
+            signs.append(float(np.sign(axis @ self.plane.normal)))
+        return PlanarChain(origins.reshape(self.dof, 2), np.array(signs))
+
+    @cached_property
+    def node_polygon(self) -> np.ndarray:
+        """(N,) index of the polygon each node (vertex) belongs to."""
+        return np.concatenate([np.full(len(p.vertices0), i) for i, p in enumerate(self.polygons)])
+
+    @cached_property
+    def node_body(self) -> np.ndarray:
+        """(N,) body index of each node."""
+        return np.array([self.polygons[i].body for i in self.node_polygon])
+
+    @cached_property
+    def nodes0(self) -> np.ndarray:
+        """(N, 2) node positions at q = 0."""
+        return np.concatenate([p.vertices0 for p in self.polygons])
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.nodes0)
+
+    @cached_property
+    def reach(self) -> float:
+        """Upper bound on the distance of any robot point from joint 1 (m): the arm's reach.
+
+        Chains the joint-to-joint distances: |p − o_1| ≤ Σ_{i<b} |o_{i+1} − o_i| + |p − o_b|.
+        """
+        o = self.chain.joint_origins
+        hops = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(o, axis=0), axis=1))])
+        body = np.maximum(self.node_body, 1) - 1
+        return float(np.max(hops[body] + np.linalg.norm(self.nodes0 - o[body], axis=1)))
+
+    # ---------------------------------------------------------------- sampling and checks
+    def sample(self, n: int, seed: int | None = 0) -> np.ndarray:
+        """(n, dof) configurations uniform within the joint limits."""
+        rng = np.random.default_rng(seed)
+        return rng.uniform(self.lower, self.upper, size=(n, self.dof))
+
+    def check_q(self, q: np.ndarray, name: str = "q") -> np.ndarray:
+        """Validate joint angles: returns a float64 (B, dof) array; raises InputError otherwise."""
+        return as_batch(q, self.dof, name)
+
+    def within_limits(self, q: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+        """(B,) True where every joint is within its limits."""
+        q = self.check_q(q)
+        return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=1)
+
+    # ---------------------------------------------------------------- kinematics
+    def node_positions(self, q: np.ndarray) -> np.ndarray:
+        """(B, N, 2) world positions of all polygon vertices at a batch q (B, dof)."""
+        q = self.check_q(q)
+        return self.chain.transform(self.nodes0, self.node_body, q)
+
+    def node_jacobians(self, q: np.ndarray) -> np.ndarray:
+        """(B, N, 2, dof) Jacobians of the node positions with respect to q."""
+        q = self.check_q(q)
+        points = self.chain.transform(self.nodes0, self.node_body, q)
+        return self.chain.jacobian(points, self.node_body, q)
+
+    def link_polygons(self, q: np.ndarray) -> list[np.ndarray]:
+        """World polygons (m_k, 2) of one configuration q (dof,)."""
+        q = np.asarray(q, dtype=float)
+        if q.ndim != 1:
+            raise InputError(f"q: expected one configuration of shape ({self.dof},), got {q.shape}")
+        nodes = self.node_positions(q[None])[0]
+        return [nodes[self.node_polygon == i] for i in range(self.n_links)]
+
+    def body_poses(self, q: np.ndarray) -> np.ndarray:
+        """(B, dof + 1, 3) planar poses (x, y, θ) of every body; body 0 is the fixed base.
+
+        The pose maps q = 0 plane coordinates of a body point p⁰ to p = R(θ)p⁰ + (x, y). Body b
+        hangs from joint b − 1 at o_{b−1} (q = 0 coordinates), so composing one joint more,
+
+            θ_b = θ_{b−1} + s_{b−1} q_{b−1},    t_b = t_{b−1} + R(θ_{b−1}) o_{b−1} − R(θ_b) o_{b−1},
+
+        with θ_0 = 0, t_0 = 0: two cumulative sums over the chain, no loop over joints.
+        """
+        q = self.check_q(q)
+        theta = np.concatenate([np.zeros((len(q), 1)), np.cumsum(q * self.chain.joint_signs, 1)], 1)
+        c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]  # (B, dof + 1, 1)
+        ox, oy = self.chain.joint_origins[:, :1], self.chain.joint_origins[:, 1:]  # (dof, 1)
+
+        def rotated(k: slice) -> np.ndarray:  # R(θ_k) o (B, dof, 2) for θ_k = θ[:, k]
+            return np.concatenate([c[:, k] * ox - s[:, k] * oy, s[:, k] * ox + c[:, k] * oy], -1)
+
+        steps = rotated(slice(0, -1)) - rotated(slice(1, None))
+        origin = np.concatenate([np.zeros((len(q), 1, 2)), np.cumsum(steps, 1)], 1)
+        return np.concatenate([origin, theta[..., None]], -1)
+
+    def node_positions_pinocchio(self, q: np.ndarray) -> np.ndarray:
+        """Reference node positions (B, N, 2) from Pinocchio frame placements."""
+        q = self.check_q(q)
+        data = self.model.createData()
+        out = np.empty((len(q), self.n_nodes, 2))
+        for b, qb in enumerate(q):
+            pin.framesForwardKinematics(self.model, data, qb)
+            rows = [apply_se3(data.oMf[p.frame], p.vertices_frame) for p in self.polygons]
+            out[b] = self.plane.project(np.concatenate(rows))
+        return out
+
+    def node_jacobians_pinocchio(self, q: np.ndarray) -> np.ndarray:
+        """Reference node Jacobians (B, N, 2, dof) from Pinocchio frame Jacobians.
+
+        For a point p on frame f: ṗ = v_f + ω_f × (p − o_f) with (v_f, ω_f) the frame's
+        LOCAL_WORLD_ALIGNED twist, projected on the plane axes.
+        """
+        q = self.check_q(q)
+        data = self.model.createData()
+        out = np.empty((len(q), self.n_nodes, 2, self.dof))
+        frame_ref = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        for b, qb in enumerate(q):
+            pin.computeJointJacobians(self.model, data, qb)
+            pin.updateFramePlacements(self.model, data)
+            n = 0
+            for p in self.polygons:
+                jac = pin.getFrameJacobian(self.model, data, p.frame, frame_ref)
+                o = data.oMf[p.frame].translation
+                for x in apply_se3(data.oMf[p.frame], p.vertices_frame):
+                    lin = jac[:3] - np.cross(x - o, jac[3:].T).T  # v + ω × r = v − r × ω
+                    out[b, n] = self.plane.axes @ lin
+                    n += 1
+        return out
+
+
+def apply_se3(placement: pin.SE3, points: np.ndarray) -> np.ndarray:
+    """Apply a rigid transform to points (k, 3)."""
+    return points @ placement.rotation.T + placement.translation
+
+
+def _joint_axis(model: pin.Model, j: int) -> np.ndarray:
+    """Unit axis of revolute joint j in its own frame."""
+    shortname = model.joints[j].shortname()
+    fixed = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1)}
+    if shortname in fixed:
+        return np.array(fixed[shortname], dtype=float)
+    if shortname == "JointModelRevoluteUnaligned":
+        return np.asarray(model.joints[j].extract().axis, dtype=float)
+    raise InputError(f"joint {model.names[j]!r}: only revolute joints can be planning joints")
+
+
+def first_outside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, tol: float = 1e-9):
+    """Index of the first joint of q (dof,) outside [lower − tol, upper + tol], or None."""
+    out = np.flatnonzero((q < lower - tol) | (q > upper + tol))
+    return int(out[0]) if out.size else None
+
+
+def as_batch(q: np.ndarray, dof: int, name: str = "q") -> np.ndarray:
+    """Return q as a float64 (B, dof) array; a single (dof,) configuration becomes (1, dof)."""
+    try:
+        q = np.asarray(q, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from e
+    if q.ndim not in (1, 2) or q.shape[-1] != dof:
+        raise InputError(f"{name}: expected shape (B, {dof}) or ({dof},), got {q.shape}")
+    q = q.reshape(-1, dof)
+    if not np.all(np.isfinite(q)):
+        raise InputError(f"{name}: contains NaN or infinite values")
+    return q
+
+
+# -------------------------------------------------------------------- building robots
+def geometry_points(geometry, samples: int = 24) -> np.ndarray:
+    """Surface points (k, 3) of a coal collision geometry in its own frame.
+
+    Boxes give their corners, cylinders/capsules/spheres rings of ``samples`` points, meshes
+    their vertices.
+    """
+    import coal
+
+    ang = np.linspace(0, 2 * np.pi, samples, endpoint=False)
+    ring = np.stack([np.cos(ang), np.sin(ang), np.zeros_like(ang)], 1)
+    if isinstance(geometry, coal.Box):
+        h = np.asarray(geometry.halfSide)
+        corners = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
+        return corners * h
+    if isinstance(geometry, coal.Sphere):
+        return _sphere_points(geometry.radius, ang)
+    if isinstance(geometry, (coal.Cylinder, coal.Capsule)):
+        r, h = geometry.radius, geometry.halfLength
+        pts = [ring * r + [0, 0, z] for z in (-h, h)]
+        if isinstance(geometry, coal.Capsule):
+            pts += [_sphere_points(r, ang) + np.array([0.0, 0.0, z]) for z in (-h, h)]
+        return np.concatenate(pts)
+    if hasattr(geometry, "vertices"):  # BVH meshes and convex hulls
+        return np.asarray(geometry.vertices())
+    if hasattr(geometry, "points"):
+        return np.asarray(geometry.points())
+    raise InputError(f"geometry: unsupported collision shape {type(geometry).__name__}")
+
+
+def _sphere_points(radius: float, ang: np.ndarray) -> np.ndarray:
+    """Points on three great circles of a sphere: enough for the hull of any projection."""
+    c, s, z = np.cos(ang), np.sin(ang), np.zeros_like(ang)
+    return radius * np.concatenate(
+        [np.stack([c, s, z], 1), np.stack([c, z, s], 1), np.stack([z, c, s], 1)]
+    )
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """How to turn a URDF into a planar :class:`Robot`.
+
+    Attributes:
+        urdf: path of the URDF (meshes resolved from ``package_dirs``).
+        planning_joints: names of the joints that move (a serial chain, base to tip).
+        locked: values of every other joint (rad); unlisted non-planning joints lock at 0.
+        plane_axes: (2, 3) world directions of the plane coordinates u, v.
+        max_vertices: each link polygon is simplified to at most this many vertices.
+        base_radius: keep-out radius around joint 1 for generated obstacles (m).
+    """
+
+    urdf: Path
+    planning_joints: tuple[str, ...]
+    locked: dict[str, float] = field(default_factory=dict)
+    plane_axes: tuple[tuple[float, ...], tuple[float, ...]] = ((1, 0, 0), (0, 1, 0))
+    package_dirs: tuple[str, ...] = ()
+    max_vertices: int = 12
+    base_radius: float = 0.15
+
+
+def robot_from_urdf(
+    name: str,
+    spec: RobotSpec,
+    limits: tuple[np.ndarray, np.ndarray] | None = None,
+    extra_polygons: Sequence[tuple[str, str, np.ndarray]] = (),
+    skip_geometry: Callable[[str], bool] = lambda _: False,
+    info: dict | None = None,
+) -> Robot:
+    """Load a URDF with Pinocchio, lock non-planning joints and project link geometry.
+
+    Each collision geometry becomes the convex hull of its projection on the plane (simplified
+    to ``spec.max_vertices``). ``extra_polygons`` adds hand-made polygons as
+    ``(name, frame_name, vertices (m, 2) in plane coordinates at q = 0)``.
+    """
+    model, geom = _load_urdf(spec)
+    return robot_from_models(name, model, geom, spec, limits, extra_polygons, skip_geometry, info)
+
+
+def robot_from_models(
+    name: str,
+    model: pin.Model,
+    geom: pin.GeometryModel,
+    spec: RobotSpec,
+    limits: tuple[np.ndarray, np.ndarray] | None = None,
+    extra_polygons: Sequence[tuple[str, str, np.ndarray]] = (),
+    skip_geometry: Callable[[str], bool] = lambda _: False,
+    info: dict | None = None,
+    group: Callable[[str], str] | None = None,
+) -> Robot:
+    """:func:`robot_from_urdf` on an already-built full model and its collision geometry.
+
+    ``spec.urdf`` only names the source in messages and ``info``. ``group`` maps geometry
+    names to polygon names: geometries of one group (all on one body) share one polygon, the
+    convex hull of their joint projection. Without it every geometry is its own polygon.
+    """
+    q_ref = pin.neutral(model)
+    for jname, value in spec.locked.items():
+        if not model.existJointName(jname):
+            raise UnknownNameError(f"locked joint {jname!r} is not in {spec.urdf.name}")
+        q_ref[model.joints[model.getJointId(jname)].idx_q] = value
+    for jname in spec.planning_joints:
+        if not model.existJointName(jname):
+            raise UnknownNameError(f"planning joint {jname!r} is not in {spec.urdf.name}")
+    lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in spec.planning_joints]
+    reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
+    for j in range(1, reduced.njoints):
+        if reduced.parents[j] != j - 1 or reduced.joints[j].nq != 1:
+            raise InputError(f"{name}: planning joints must form a serial chain of revolute joints")
+
+    data = reduced.createData()
+    gdata = pin.GeometryData(reduced_geom)
+    q0 = np.zeros(reduced.nq)
+    pin.framesForwardKinematics(reduced, data, q0)
+    pin.updateGeometryPlacements(reduced, data, reduced_geom, gdata)
+    origin = data.oMi[1].translation.copy()
+    plane = Plane(origin=origin, axes=np.asarray(spec.plane_axes, dtype=float))
+
+    groups: dict[tuple, tuple[int, list[np.ndarray]]] = {}  # (key, name) -> (frame, points)
+    for g, obj in enumerate(reduced_geom.geometryObjects):
+        if skip_geometry(obj.name):
+            continue
+        pts = apply_se3(gdata.oMg[g], geometry_points(obj.geometry))
+        key = (g, obj.name) if group is None else (None, group(obj.name))
+        frame, clouds = groups.setdefault(key, (obj.parentFrame, []))
+        if reduced.frames[frame].parentJoint != reduced.frames[obj.parentFrame].parentJoint:
+            raise InputError(f"{name}: geometry {obj.name!r} moves apart from group {key[1]!r}")
+        clouds.append(plane.project(pts))
+    polygons = []
+    for (_, pname), (frame, clouds) in groups.items():
+        uv = simplify_convex(convex_hull(np.concatenate(clouds)), spec.max_vertices)
+        polygons.append(_attach(reduced, data, plane, pname, frame, uv))
+    for pname, frame_name, uv in extra_polygons:
+        if not reduced.existFrame(frame_name):
+            raise UnknownNameError(f"{name}: frame {frame_name!r} does not exist")
+        frame = reduced.getFrameId(frame_name)
+        polygons.append(_attach(reduced, data, plane, pname, frame, np.asarray(uv, float)))
+
+    lower = reduced.lowerPositionLimit.copy() if limits is None else np.asarray(limits[0], float)
+    upper = reduced.upperPositionLimit.copy() if limits is None else np.asarray(limits[1], float)
+    return Robot(
+        name=name,
+        model=reduced,
+        plane=plane,
+        polygons=tuple(polygons),
+        lower=lower,
+        upper=upper,
+        base_radius=spec.base_radius,
+        info=dict(info or {}, urdf=str(spec.urdf)),
+    )
+
+
+def _load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
+    if not Path(spec.urdf).exists():
+        raise UnknownNameError(f"urdf: file {spec.urdf} does not exist")
+    model = pin.buildModelFromUrdf(str(spec.urdf))
+    geom = pin.buildGeomFromUrdf(
+        model, str(spec.urdf), pin.GeometryType.COLLISION, package_dirs=list(spec.package_dirs)
+    )
+    return model, geom
+
+
+def _attach(model, data, plane: Plane, name: str, frame: int, uv: np.ndarray) -> LinkPolygon:
+    """A polygon given at q = 0 in plane coordinates, attached to a frame."""
+    joint = model.frames[frame].parentJoint
+    local = apply_se3(data.oMf[frame].inverse(), plane.lift(uv))
+    return LinkPolygon(
+        name=name, body=int(joint), frame=int(frame), vertices0=uv, vertices_frame=local
+    )
+
+
+# -------------------------------------------------------------------- registry
+_REGISTRY: dict[str, Callable[..., Robot]] = {}
+
+
+def register_robot(name: str) -> Callable:
+    """Decorator registering a robot factory under ``name`` for :func:`load_robot`."""
+
+    def wrap(factory: Callable[..., Robot]) -> Callable[..., Robot]:
+        _REGISTRY[name] = factory
+        return factory
+
+    return wrap
+
+
+def robot_names() -> list[str]:
+    return sorted(_REGISTRY)
+
+
+def load_robot(name: str, **options) -> Robot:
+    """Build a registered robot (``planar2``, ``planar7``, ``ur5e``, ``ur5``) by name.
+
+    Options are passed to the factory (e.g. ``gripper="holding", stick_length=0.3`` for ur5e).
+    Results without options are cached: the same name returns the same object.
+    """
+    if name not in _REGISTRY:
+        raise UnknownNameError(f"robot: unknown name {name!r}; choose one of {robot_names()}")
+    if options:
+        return _REGISTRY[name](**options)
+    if name not in _CACHE:
+        _CACHE[name] = _REGISTRY[name]()
+    return _CACHE[name]
+
+
+_CACHE: dict[str, Robot] = {}
+
+
+def _planar(name: str) -> Robot:
+    spec = RobotSpec(
+        urdf=robot_urdf(name),
+        planning_joints=tuple(f"joint{i}" for i in range(1, int(name[-1]) + 1)),
+    )
+    return robot_from_urdf(name, spec)
+
+
+@register_robot("planar2")
+def planar2() -> Robot:
+    """Two 0.6 m links, 0.06 m wide, joints limited to ±π: reach 1.2 m."""
+    return _planar("planar2")
+
+
+@register_robot("planar7")
+def planar7() -> Robot:
+    """Seven 0.3 m links, 0.06 m wide, joints limited to ±π: reach 2.1 m."""
+    return _planar("planar7")

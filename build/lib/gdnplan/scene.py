@@ -1,0 +1,286 @@
+"""Scenes: a robot among obstacle polygons, and the generators of the paper's environments.
+
+Environments (paper §V-A, Fig. 4):
+
+====  =========  ==================================================================
+name  robot      obstacles
+====  =========  ==================================================================
+a     planar2    one fixed 0.3 m square
+b     planar2    one 0.3 m square at a random pose within reach
+c     planar7    20 squares of 0.2 m at a fixed layout (layout of ``d`` with seed 2022)
+d     planar7    20 squares of 0.2 m, random centres in [-2, 2]², random rotations
+e     planar7    5 random α-shapes: 20 uniform points in a unit square, α = 0.6
+                 (circumradius bound), largest piece, at most 15 vertices, scaled to 0.7 m
+====  =========  ==================================================================
+
+No obstacle comes within ``robot.base_radius`` of the first joint.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+
+import numpy as np
+from shapely.geometry import Point, Polygon
+
+from .errors import InputError, ProblemFileError, UnknownNameError
+from .geometry import (
+    alpha_shape,
+    as_polygon,
+    check_part,
+    convex_decomposition,
+    limit_vertices,
+    square,
+)
+from .robot import Robot, load_robot
+
+MAX_OBSTACLES = 1000  # obstacle polygons of one scene
+MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
+
+
+def coordinate_bound(robot: Robot) -> float:
+    """Largest |x|, |y| offset (m) of an obstacle vertex from joint 1: max(100 m, 100 × reach).
+    Farther obstacles can never touch the arm, and huge coordinates (1e300) crashed coal."""
+    return max(100.0, 100.0 * robot.reach)
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A robot and the obstacles around it (world plane coordinates, metres).
+
+    Attributes:
+        robot: the robot (with its current gripper state, where it has one).
+        obstacles: simple CCW polygons (m, 2); non-convex ones are split for coal. Checked:
+            at most ``MAX_OBSTACLES`` polygons of ``geometry.MAX_VERTICES`` vertices,
+            finite, within :func:`coordinate_bound` of joint 1, no repeated vertices, every
+            convex part at least ``geometry.MIN_THICKNESS`` thick (:func:`check_part`).
+        name: generator name or ``"custom"``.
+        seed: generator seed, when generated.
+        info: generator metadata (e.g. the fetch scene's storage and stick).
+    """
+
+    robot: Robot
+    obstacles: tuple[np.ndarray, ...]
+    name: str = "custom"
+    seed: int | None = None
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if len(self.obstacles) > MAX_OBSTACLES:
+            raise InputError(
+                f"obstacles: {len(self.obstacles)} polygons, the limit is {MAX_OBSTACLES}"
+            )
+        checked = tuple(as_polygon(p, f"obstacles[{i}]") for i, p in enumerate(self.obstacles))
+        object.__setattr__(self, "obstacles", checked)
+        bound = coordinate_bound(self.robot)
+        base = self.robot.chain.joint_origins[0]
+        for i, poly in enumerate(checked):
+            far = float(np.max(np.abs(poly - base)))
+            if far > bound:
+                raise InputError(
+                    f"obstacles[{i}]: a vertex is {far:.3g} m from the robot's base, the limit "
+                    f"is {bound:.3g} m (max(100 m, 100 × reach)); remove or move the obstacle"
+                )
+            for part in convex_decomposition(poly):
+                check_part(part, f"obstacles[{i}]")
+        if len(self.obstacle_parts) > MAX_PARTS:
+            raise InputError(
+                f"obstacles: {len(self.obstacle_parts)} convex parts, the limit is {MAX_PARTS}; "
+                "use fewer or simpler (less non-convex) obstacles"
+            )
+
+    @cached_property
+    def obstacle_parts(self) -> tuple[np.ndarray, ...]:
+        """Convex CCW parts of all obstacles (what coal sees)."""
+        return tuple(part for poly in self.obstacles for part in convex_decomposition(poly))
+
+    @cached_property
+    def part_owner(self) -> np.ndarray:
+        """(P,) index of the obstacle each convex part comes from."""
+        sizes = [len(convex_decomposition(p)) for p in self.obstacles]
+        return np.repeat(np.arange(len(self.obstacles)), sizes)
+
+    def with_robot(self, robot: Robot) -> Scene:
+        """The same obstacles with another robot (e.g. the gripper holding a stick)."""
+        return replace(self, robot=robot)
+
+    def with_obstacles(self, obstacles) -> Scene:
+        """The same robot with other obstacles."""
+        return replace(self, obstacles=tuple(obstacles))
+
+
+# -------------------------------------------------------------------- generators
+_GENERATORS: dict[str, Callable[..., Scene]] = {}
+
+
+def register_scene(name: str) -> Callable:
+    """Decorator registering ``factory(seed, **options) -> Scene`` for :func:`make_scene`."""
+
+    def wrap(factory: Callable[..., Scene]) -> Callable[..., Scene]:
+        _GENERATORS[name] = factory
+        return factory
+
+    return wrap
+
+
+def scene_names() -> list[str]:
+    return sorted(_GENERATORS)
+
+
+def make_scene(name: str, seed: int = 0, **options) -> Scene:
+    """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
+    if name not in _GENERATORS:
+        raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
+    return _GENERATORS[name](seed=seed, **options)
+
+
+ENV_ROBOT = {"a": "planar2", "b": "planar2", "c": "planar7", "d": "planar7", "e": "planar7"}
+C_LAYOUT_SEED = 2022
+
+
+def clear_of_base(poly: np.ndarray, robot: Robot) -> bool:
+    """True when the polygon stays farther than ``robot.base_radius`` from joint 1."""
+    base = Point(*robot.chain.joint_origins[0])
+    return Polygon(poly).distance(base) > robot.base_radius
+
+
+def _place(draw: Callable[[np.random.Generator], np.ndarray], n: int, robot: Robot, rng) -> list:
+    """Draw n polygons, redrawing any that touch the base keep-out circle."""
+    out = []
+    while len(out) < n:
+        poly = draw(rng)
+        if clear_of_base(poly, robot):
+            out.append(poly)
+    return out
+
+
+@register_scene("a")
+def env_a(seed: int = 0) -> Scene:
+    """planar2 and one fixed axis-aligned 0.3 m square (the seed is ignored)."""
+    robot = load_robot("planar2")
+    return Scene(robot, (square((0.6, 0.45), 0.3),), name="a", seed=seed)
+
+
+@register_scene("b")
+def env_b(seed: int = 0) -> Scene:
+    """planar2 and one 0.3 m square, centre uniform in the disc of radius 1.3 m, any rotation."""
+    robot = load_robot("planar2")
+    rng = np.random.default_rng(seed)
+
+    def draw(rng) -> np.ndarray:
+        r, phi = 1.3 * np.sqrt(rng.uniform()), rng.uniform(0, 2 * np.pi)
+        return square((r * np.cos(phi), r * np.sin(phi)), 0.3, rng.uniform(0, np.pi / 2))
+
+    return Scene(robot, tuple(_place(draw, 1, robot, rng)), name="b", seed=seed)
+
+
+def _squares(robot: Robot, seed: int, n: int = 20) -> list[np.ndarray]:
+    rng = np.random.default_rng(seed)
+    return _place(
+        lambda g: square(g.uniform(-2, 2, 2), 0.2, g.uniform(0, np.pi / 2)), n, robot, rng
+    )
+
+
+@register_scene("c")
+def env_c(seed: int = 0) -> Scene:
+    """planar7 and the fixed layout of 20 squares (env d drawn with seed 2022; seed ignored)."""
+    robot = load_robot("planar7")
+    return Scene(robot, tuple(_squares(robot, C_LAYOUT_SEED)), name="c", seed=seed)
+
+
+@register_scene("d")
+def env_d(seed: int = 0) -> Scene:
+    """planar7 and 20 squares of 0.2 m, centres uniform in [-2, 2]², rotations uniform."""
+    robot = load_robot("planar7")
+    return Scene(robot, tuple(_squares(robot, seed)), name="d", seed=seed)
+
+
+def random_alpha_shape(
+    rng: np.random.Generator, size: float = 0.7, alpha: float = 0.6, max_vertices: int = 15
+) -> np.ndarray:
+    """One α-shape obstacle centred at the origin (paper: 20 points, ≤ 15 connected, α = 0.6).
+
+    20 points uniform in the unit square, α-shape with circumradius bound ``alpha`` (unit
+    square units), largest piece, at most ``max_vertices`` vertices, scaled to ``size`` m.
+    """
+    while True:
+        points = rng.uniform(0, 1, (20, 2))
+        try:
+            poly = limit_vertices(alpha_shape(points, alpha), max_vertices)
+        except InputError:
+            continue
+        return (poly - poly.mean(0)) * size
+
+
+@register_scene("e")
+def env_e(seed: int = 0) -> Scene:
+    """planar7 and 5 random α-shapes with centres uniform in [-1.8, 1.8]²."""
+    robot = load_robot("planar7")
+    rng = np.random.default_rng(seed)
+    shapes = _place(lambda g: random_alpha_shape(g) + g.uniform(-1.8, 1.8, 2), 5, robot, rng)
+    return Scene(robot, tuple(shapes), name="e", seed=seed)
+
+
+# -------------------------------------------------------------------- from configuration
+def scene_from_config(cfg: dict) -> Scene:
+    """Scene from a problem TOML mapping: ``[robot]``, optional ``[scene]``, ``[[obstacles]]``.
+
+    ``[robot] name`` (plus options such as ``gripper``) selects the robot; ``[scene] generator``
+    and ``seed`` draw generated obstacles; each ``[[obstacles]] polygon`` adds one polygon.
+    """
+    robot_cfg = cfg.get("robot", {})
+    scene_cfg = cfg.get("scene", {})
+    if not isinstance(robot_cfg, dict) or not isinstance(scene_cfg, dict):
+        raise ProblemFileError("[robot] and [scene] must be tables")
+    obstacles = []
+    name, seed, info = "custom", None, {}
+    base = None
+    if "generator" in scene_cfg:
+        seed = scene_cfg.get("seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise ProblemFileError(f"[scene] seed: expected an integer ≥ 0, got {seed!r}")
+        generator = scene_cfg["generator"]
+        if not isinstance(generator, str):
+            raise ProblemFileError(f"[scene] generator: expected a name, got {generator!r}")
+        options = {k: v for k, v in scene_cfg.items() if k not in ("generator", "seed")}
+        base = _call("[scene]", make_scene, generator, seed=seed, **options)
+        obstacles += list(base.obstacles)
+        name, info = base.name, dict(base.info)
+    if "name" in robot_cfg:
+        options = {k: v for k, v in robot_cfg.items() if k != "name"}
+        if not isinstance(robot_cfg["name"], str):
+            raise ProblemFileError(f"[robot] name: expected a name, got {robot_cfg['name']!r}")
+        robot = _call("[robot]", load_robot, robot_cfg["name"], **options)
+    elif base is not None:
+        robot = base.robot
+    else:
+        raise ProblemFileError("[robot] name: missing; give a robot name (e.g. planar7)")
+    extra = cfg.get("obstacles", [])
+    if not isinstance(extra, list):
+        raise ProblemFileError("[[obstacles]]: expected an array of tables with a polygon each")
+    for i, item in enumerate(extra):
+        if not isinstance(item, dict) or "polygon" not in item:
+            raise ProblemFileError(f"[[obstacles]] #{i}: missing 'polygon = [[x, y], ...]'")
+        if set(item) != {"polygon"}:
+            unknown = sorted(set(item) - {"polygon"})
+            raise ProblemFileError(f"[[obstacles]] #{i}: unknown key(s) {unknown}; only polygon")
+        try:
+            obstacles.append(as_polygon(item["polygon"], f"obstacles[{i}].polygon"))
+        except InputError as e:
+            raise ProblemFileError(str(e)) from e
+    return _call("[[obstacles]]", Scene, robot, tuple(obstacles), name=name, seed=seed, info=info)
+
+
+def _call(where: str, factory: Callable, *args, **options):
+    """factory(*args, **options), with an unsupported option or a bad value (TypeError,
+    InputError) reported as a ProblemFileError naming the table."""
+    try:
+        return factory(*args, **options)
+    except UnknownNameError:
+        raise
+    except (TypeError, InputError) as e:
+        raise ProblemFileError(f"{where}: {e}") from e
