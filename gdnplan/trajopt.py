@@ -43,6 +43,7 @@ from .ccd import Certificate, certify_path, verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, ProblemFileError
 from .limits import (
+    IPOPT_OPTIONS,
     MAX_ADAM_ITERATIONS,
     MAX_CHECK_POINTS,
     MAX_INTERPOLATED,
@@ -59,11 +60,15 @@ from .limits import (
 from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot, first_outside
 from .rrt import seed_path
-from .scene import Scene, scene_from_config
+from .scene import Scene, no_unknown_keys, scene_from_config
 
 WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
 WEIGHTS_FOR_SCENE = {"fetch": "ur5e"}  # scene name -> shipped weights name, where they differ
-TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options", "solver"}
+# problem-file keys (docs/problem_file.md documents each; tests/test_problem_file_docs.py checks);
+# [robot], [scene], [[obstacles]]: scene.ROBOT_KEYS etc.; [solver]: SOLVER_KEYS
+TOP_KEYS = frozenset({"robot", "scene", "obstacles", "start", "goal", "options", "solver"})
+START_KEYS = frozenset({"q"})
+GOAL_KEYS = frozenset({"q", "position"})  # exactly one of them
 INITIAL_GUESSES = ("auto", "straight", "rrt")
 SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
 WARM_START_OPTIONS = {  # Ipopt options of refine rounds started from the last primal-dual point
@@ -74,7 +79,7 @@ WARM_START_OPTIONS = {  # Ipopt options of refine rounds started from the last p
     "warm_start_mult_bound_push": 1e-6,
 }
 IPOPT_INTERPOLATED, ADAM_INTERPOLATED = 2, 3  # TrajoptOptions.interpolated=None per solver
-OPTION_KEYS = {"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"}
+OPTION_KEYS = frozenset({"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"})
 
 
 # -------------------------------------------------------------------- end effector
@@ -210,7 +215,8 @@ class Problem:
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Problem:
-        """Load a problem file (schema in DESIGN.md); ProblemFileError names any bad field."""
+        """Load a problem file (schema: ``docs/problem_file.md``); ProblemFileError names any
+        bad field."""
         cfg = read_problem_file(path)
         try:
             return cls.from_config(cfg)
@@ -223,9 +229,9 @@ class Problem:
         _no_unknown(cfg, TOP_KEYS, "top level")
         for key in ("start", "goal"):
             if not isinstance(cfg.get(key), dict):
-                raise ProblemFileError(f"[{key}]: missing table")
-        _no_unknown(cfg["start"], {"q"}, "[start]")
-        _no_unknown(cfg["goal"], {"q", "position"}, "[goal]")
+                raise ProblemFileError(f"[{key}]: missing table", schema=True)
+        _no_unknown(cfg["start"], START_KEYS, "[start]")
+        _no_unknown(cfg["goal"], GOAL_KEYS, "[goal]")
         options = cfg.get("options", {})
         if not isinstance(options, dict):
             raise ProblemFileError("[options]: expected a table")
@@ -237,9 +243,11 @@ class Problem:
             raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
         goal = cfg["goal"]
         if ("q" in goal) == ("position" in goal):
-            raise ProblemFileError("[goal]: give exactly one of q = [...] or position = [x, y]")
+            raise ProblemFileError(
+                "[goal]: give exactly one of q = [...] or position = [x, y]", schema=True
+            )
         if "q" not in cfg["start"]:
-            raise ProblemFileError("[start] q: missing; give the start joint angles")
+            raise ProblemFileError("[start] q: missing; give the start joint angles", schema=True)
         try:
             return cls(
                 scene=scene,
@@ -292,7 +300,9 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
         return None
     if not isinstance(table, dict):
         raise ProblemFileError("[solver]: expected a table")
-    _no_unknown(table, {f.name for f in fields(TrajoptOptions)}, "[solver]")
+    _no_unknown(table, SOLVER_KEYS, "[solver]")
+    if isinstance(table.get("ipopt"), dict):
+        _no_unknown(table["ipopt"], IPOPT_OPTIONS.keys(), "[solver.ipopt]")
     defaults = TrajoptOptions()
     for key, value in table.items():
         default = getattr(defaults, key)  # None: int or bool settings with an automatic choice
@@ -309,10 +319,7 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
         raise ProblemFileError(f"[solver] {e}") from e
 
 
-def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ProblemFileError(f"{where}: unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+_no_unknown = no_unknown_keys  # the check of every table's keys (cli.py uses it too)
 
 
 def _vector(value, n: int, name: str) -> np.ndarray:
@@ -486,6 +493,9 @@ class TrajoptOptions:
         if check_number(self.rrt_time, "rrt_time", strict=True) > MAX_RRT_TIME:
             raise InputError(f"rrt_time: {self.rrt_time} s is over the limit {MAX_RRT_TIME} s")
         check_ipopt(self.ipopt)
+
+
+SOLVER_KEYS = frozenset(f.name for f in fields(TrajoptOptions))  # a problem file's [solver]
 
 
 @dataclass(frozen=True, eq=False)
