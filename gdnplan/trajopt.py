@@ -310,7 +310,7 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
         if default is not None and (
             not isinstance(value, kind) or isinstance(value, bool) != isinstance(default, bool)
         ):
-            names = {float: "a number", int: "an integer", bool: "true or false"}
+            names = {float: "a number", int: "an integer", bool: "true or false", dict: "a table"}
             wanted = names.get(type(default), f"a {type(default).__name__}")
             raise ProblemFileError(f"[solver] {key}: expected {wanted}, got {value!r}")
     try:
