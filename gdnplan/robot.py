@@ -150,7 +150,8 @@ class Robot:
         model: Pinocchio model reduced to the planning joints (a serial chain).
         plane: the plane the robot moves in.
         polygons: convex link polygons (the robot graph's nodes are their vertices).
-        lower, upper: (dof,) joint limits (rad).
+        lower: (dof,) lower joint limits (rad).
+        upper: (dof,) upper joint limits (rad).
         base_radius: obstacles are never placed within this radius of joint 1 (m).
         info: free-form metadata (gripper state, stick size, source URDF).
     """

@@ -117,7 +117,8 @@ class Problem:
         margin: required clearance d ≥ margin (m).
         max_step: largest change of any joint between consecutive waypoints (rad).
         goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
-        lower, upper: (dof,) joint limits (rad), within the robot's; the robot's when None.
+        lower: (dof,) lower joint limits (rad), within the robot's; the robot's when None.
+        upper: (dof,) upper joint limits (rad), within the robot's; the robot's when None.
         solver: the solver settings this problem needs (a problem file's ``[solver]`` table,
             e.g. short RRT-Connect steps for a narrow passage); :func:`plan` uses them unless
             it is given ``options``. None: the defaults.
@@ -442,8 +443,12 @@ class TrajoptOptions:
         link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
         ipopt: extra Ipopt options (name → value) over the defaults, e.g.
             ``{"limited_memory_initialization": "scalar1"}`` (Ipopt's own default).
-        adam_iterations, adam_lr, adam_c, adam_eps, adam_stop: the paper's Adam optimiser:
-            iteration cap, step size (rad), cost constant c, ε, and the stop clearance (m).
+        adam_iterations: the paper's Adam optimiser: iteration cap.
+        adam_lr: the Adam optimiser's step size (rad).
+        adam_c: the Adam optimiser's collision-cost constant c.
+        adam_eps: the Adam optimiser's collision-cost ε.
+        adam_stop: the Adam optimiser stops once every check point is this far above the
+            margin (m).
     """
 
     initial: str = "auto"
