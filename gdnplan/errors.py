@@ -18,8 +18,20 @@ class InputError(GdnplanError, ValueError):
     """An array of the wrong shape, a NaN, a value outside its limits."""
 
 
+SCHEMA_DOC = "docs/problem_file.md"  # the problem-file schema, every table and key
+
+
 class ProblemFileError(GdnplanError, ValueError):
-    """A malformed or inconsistent problem TOML file."""
+    """A malformed or inconsistent problem TOML file.
+
+    Args:
+        message: one line naming the table or key and the fix.
+        schema: the error is about the file's tables and keys (an unknown or missing one):
+            the message then ends with a pointer to the schema, ``(see docs/problem_file.md)``.
+    """
+
+    def __init__(self, message: str, *, schema: bool = False) -> None:
+        super().__init__(f"{message} (see {SCHEMA_DOC})" if schema else message)
 
 
 class InfeasibleProblemError(GdnplanError):

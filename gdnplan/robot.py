@@ -17,6 +17,7 @@ stays the reference (``Robot.node_positions_pinocchio``) and a test proves the t
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -148,7 +149,8 @@ class Robot:
         model: Pinocchio model reduced to the planning joints (a serial chain).
         plane: the plane the robot moves in.
         polygons: convex link polygons (the robot graph's nodes are their vertices).
-        lower, upper: (dof,) joint limits (rad).
+        lower: (dof,) lower joint limits (rad).
+        upper: (dof,) upper joint limits (rad).
         base_radius: obstacles are never placed within this radius of joint 1 (m).
         info: free-form metadata (gripper state, stick size, source URDF).
     """
@@ -533,6 +535,20 @@ def register_robot(name: str) -> Callable:
 
 def robot_names() -> list[str]:
     return sorted(_REGISTRY)
+
+
+def robot_options(name: str) -> set[str]:
+    """The options :func:`load_robot` takes for the registered robot ``name`` (its factory's
+    keyword parameters, e.g. ``gripper`` for ur5e): the ``[robot]`` keys beyond ``name``."""
+    if name not in _REGISTRY:
+        raise UnknownNameError(f"robot: unknown name {name!r}; choose one of {robot_names()}")
+    return factory_options(_REGISTRY[name])
+
+
+def factory_options(factory: Callable) -> set[str]:
+    """Names of the parameters of ``factory`` that can be given by keyword."""
+    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    return {p.name for p in inspect.signature(factory).parameters.values() if p.kind in kinds}
 
 
 def load_robot(name: str, **options) -> Robot:

@@ -18,7 +18,7 @@ No obstacle comes within ``robot.base_radius`` of the first joint.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Set
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
@@ -34,10 +34,14 @@ from .geometry import (
     limit_vertices,
     square,
 )
-from .robot import Robot, load_robot
+from .robot import Robot, factory_options, load_robot, robot_names, robot_options
 
 MAX_OBSTACLES = 1000  # obstacle polygons of one scene
 MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
+# problem-file keys (docs/problem_file.md documents each; tests/test_problem_file_docs.py checks)
+ROBOT_KEYS = frozenset({"name"})  # [robot]; plus the options of the named robot (robot_options)
+SCENE_KEYS = frozenset({"generator", "seed"})  # [scene]; plus the generator's (scene_options)
+OBSTACLE_KEYS = frozenset({"polygon"})  # each [[obstacles]] table
 
 
 def coordinate_bound(robot: Robot) -> float:
@@ -127,6 +131,14 @@ def register_scene(name: str) -> Callable:
 
 def scene_names() -> list[str]:
     return sorted(_GENERATORS)
+
+
+def scene_options(name: str) -> set[str]:
+    """The options :func:`make_scene` takes for the generator ``name`` besides ``seed`` (e.g.
+    ``gripper`` for fetch): the ``[scene]`` keys beyond ``generator`` and ``seed``."""
+    if name not in _GENERATORS:
+        raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
+    return factory_options(_GENERATORS[name]) - {"seed"}
 
 
 def make_scene(name: str, seed: int = 0, **options) -> Scene:
@@ -246,33 +258,55 @@ def scene_from_config(cfg: dict) -> Scene:
         generator = scene_cfg["generator"]
         if not isinstance(generator, str):
             raise ProblemFileError(f"[scene] generator: expected a name, got {generator!r}")
+        if generator in _GENERATORS:  # an unknown name is make_scene's UnknownNameError
+            allowed = SCENE_KEYS | scene_options(generator)
+            no_unknown_keys(scene_cfg, allowed, f"[scene] (generator {generator!r})")
         options = {k: v for k, v in scene_cfg.items() if k not in ("generator", "seed")}
         base = _call("[scene]", make_scene, generator, seed=seed, **options)
         obstacles += list(base.obstacles)
         name, info = base.name, dict(base.info)
+    elif scene_cfg:
+        keys = sorted(scene_cfg)
+        raise ProblemFileError(
+            f"[scene] generator: missing; {keys} need a generator name (e.g. d)", schema=True
+        )
     if "name" in robot_cfg:
         options = {k: v for k, v in robot_cfg.items() if k != "name"}
         if not isinstance(robot_cfg["name"], str):
             raise ProblemFileError(f"[robot] name: expected a name, got {robot_cfg['name']!r}")
+        if robot_cfg["name"] in robot_names():  # an unknown name is load_robot's error
+            allowed = ROBOT_KEYS | robot_options(robot_cfg["name"])
+            no_unknown_keys(robot_cfg, allowed, f"[robot] (name {robot_cfg['name']!r})")
         robot = _call("[robot]", load_robot, robot_cfg["name"], **options)
-    elif base is not None:
+    elif base is not None and not robot_cfg:
         robot = base.robot
     else:
-        raise ProblemFileError("[robot] name: missing; give a robot name (e.g. planar7)")
+        raise ProblemFileError(
+            "[robot] name: missing; give a robot name (e.g. planar7)", schema=True
+        )
     extra = cfg.get("obstacles", [])
     if not isinstance(extra, list):
         raise ProblemFileError("[[obstacles]]: expected an array of tables with a polygon each")
     for i, item in enumerate(extra):
         if not isinstance(item, dict) or "polygon" not in item:
-            raise ProblemFileError(f"[[obstacles]] #{i}: missing 'polygon = [[x, y], ...]'")
-        if set(item) != {"polygon"}:
-            unknown = sorted(set(item) - {"polygon"})
-            raise ProblemFileError(f"[[obstacles]] #{i}: unknown key(s) {unknown}; only polygon")
+            raise ProblemFileError(
+                f"[[obstacles]] #{i}: missing 'polygon = [[x, y], ...]'", schema=True
+            )
+        no_unknown_keys(item, OBSTACLE_KEYS, f"[[obstacles]] #{i}")
         try:
             obstacles.append(as_polygon(item["polygon"], f"obstacles[{i}].polygon"))
         except InputError as e:
             raise ProblemFileError(str(e)) from e
     return _call("[[obstacles]]", Scene, robot, tuple(obstacles), name=name, seed=seed, info=info)
+
+
+def no_unknown_keys(table: dict, allowed: Set[str], where: str) -> None:
+    """ProblemFileError naming the keys of ``table`` not in ``allowed`` and listing these."""
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise ProblemFileError(
+            f"{where}: unknown key(s) {unknown}; allowed: {sorted(allowed)}", schema=True
+        )
 
 
 def _call(where: str, factory: Callable, *args, **options):

@@ -44,6 +44,7 @@ from .ccd import Certificate, certify_path, verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, ProblemFileError
 from .limits import (
+    IPOPT_OPTIONS,
     MAX_ADAM_ITERATIONS,
     MAX_CHECK_POINTS,
     MAX_INTERPOLATED,
@@ -60,9 +61,13 @@ from .limits import (
 from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot, first_outside
 from .rrt import seed_path
-from .scene import Scene, scene_from_config
+from .scene import Scene, no_unknown_keys, scene_from_config
 
-TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options", "solver"}
+# problem-file keys (docs/problem_file.md documents each; tests/test_problem_file_docs.py checks);
+# [robot], [scene], [[obstacles]]: scene.ROBOT_KEYS etc.; [solver]: SOLVER_KEYS
+TOP_KEYS = frozenset({"robot", "scene", "obstacles", "start", "goal", "options", "solver"})
+START_KEYS = frozenset({"q"})
+GOAL_KEYS = frozenset({"q", "position"})  # exactly one of them
 INITIAL_GUESSES = ("auto", "straight", "rrt")
 SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
 WARM_START_OPTIONS = {  # Ipopt options of refine rounds started from the last primal-dual point
@@ -73,7 +78,7 @@ WARM_START_OPTIONS = {  # Ipopt options of refine rounds started from the last p
     "warm_start_mult_bound_push": 1e-6,
 }
 IPOPT_INTERPOLATED, ADAM_INTERPOLATED = 2, 3  # TrajoptOptions.interpolated=None per solver
-OPTION_KEYS = {"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"}
+OPTION_KEYS = frozenset({"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"})
 
 
 # -------------------------------------------------------------------- end effector
@@ -111,7 +116,8 @@ class Problem:
         margin: required clearance d ≥ margin (m).
         max_step: largest change of any joint between consecutive waypoints (rad).
         goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
-        lower, upper: (dof,) joint limits (rad), within the robot's; the robot's when None.
+        lower: (dof,) lower joint limits (rad), within the robot's; the robot's when None.
+        upper: (dof,) upper joint limits (rad), within the robot's; the robot's when None.
         solver: the solver settings this problem needs (a problem file's ``[solver]`` table,
             e.g. short RRT-Connect steps for a narrow passage); :func:`plan` uses them unless
             it is given ``options``. None: the defaults.
@@ -210,7 +216,7 @@ class Problem:
     @classmethod
     def from_toml(cls, path: str | Path) -> Problem:
         """Load a problem file or a shipped problem by name (``"fetch_reach"``); the schema is
-        in docs/problem_file.md. ProblemFileError names any bad field."""
+        in ``docs/problem_file.md``. ProblemFileError names any bad field."""
         cfg = read_problem_file(path)
         try:
             return cls.from_config(cfg)
@@ -223,9 +229,9 @@ class Problem:
         _no_unknown(cfg, TOP_KEYS, "top level")
         for key in ("start", "goal"):
             if not isinstance(cfg.get(key), dict):
-                raise ProblemFileError(f"[{key}]: missing table")
-        _no_unknown(cfg["start"], {"q"}, "[start]")
-        _no_unknown(cfg["goal"], {"q", "position"}, "[goal]")
+                raise ProblemFileError(f"[{key}]: missing table", schema=True)
+        _no_unknown(cfg["start"], START_KEYS, "[start]")
+        _no_unknown(cfg["goal"], GOAL_KEYS, "[goal]")
         options = cfg.get("options", {})
         if not isinstance(options, dict):
             raise ProblemFileError("[options]: expected a table")
@@ -237,9 +243,11 @@ class Problem:
             raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
         goal = cfg["goal"]
         if ("q" in goal) == ("position" in goal):
-            raise ProblemFileError("[goal]: give exactly one of q = [...] or position = [x, y]")
+            raise ProblemFileError(
+                "[goal]: give exactly one of q = [...] or position = [x, y]", schema=True
+            )
         if "q" not in cfg["start"]:
-            raise ProblemFileError("[start] q: missing; give the start joint angles")
+            raise ProblemFileError("[start] q: missing; give the start joint angles", schema=True)
         try:
             return cls(
                 scene=scene,
@@ -295,7 +303,9 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
         return None
     if not isinstance(table, dict):
         raise ProblemFileError("[solver]: expected a table")
-    _no_unknown(table, {f.name for f in fields(TrajoptOptions)}, "[solver]")
+    _no_unknown(table, SOLVER_KEYS, "[solver]")
+    if isinstance(table.get("ipopt"), dict):
+        _no_unknown(table["ipopt"], IPOPT_OPTIONS.keys(), "[solver.ipopt]")
     defaults = TrajoptOptions()
     for key, value in table.items():
         default = getattr(defaults, key)  # None: int or bool settings with an automatic choice
@@ -303,7 +313,7 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
         if default is not None and (
             not isinstance(value, kind) or isinstance(value, bool) != isinstance(default, bool)
         ):
-            names = {float: "a number", int: "an integer", bool: "true or false"}
+            names = {float: "a number", int: "an integer", bool: "true or false", dict: "a table"}
             wanted = names.get(type(default), f"a {type(default).__name__}")
             raise ProblemFileError(f"[solver] {key}: expected {wanted}, got {value!r}")
     try:
@@ -312,10 +322,7 @@ def _solver_options(table: dict | None) -> TrajoptOptions | None:
         raise ProblemFileError(f"[solver] {e}") from e
 
 
-def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ProblemFileError(f"{where}: unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+_no_unknown = no_unknown_keys  # the check of every table's keys (cli.py uses it too)
 
 
 def _vector(value, n: int, name: str) -> np.ndarray:
@@ -438,8 +445,12 @@ class TrajoptOptions:
         link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
         ipopt: extra Ipopt options (name → value) over the defaults, e.g.
             ``{"limited_memory_initialization": "scalar1"}`` (Ipopt's own default).
-        adam_iterations, adam_lr, adam_c, adam_eps, adam_stop: the paper's Adam optimiser:
-            iteration cap, step size (rad), cost constant c, ε, and the stop clearance (m).
+        adam_iterations: the paper's Adam optimiser: iteration cap.
+        adam_lr: the Adam optimiser's step size (rad).
+        adam_c: the Adam optimiser's collision-cost constant c.
+        adam_eps: the Adam optimiser's collision-cost ε.
+        adam_stop: the Adam optimiser stops once every check point is this far above the
+            margin (m).
     """
 
     initial: str = "auto"
@@ -489,6 +500,9 @@ class TrajoptOptions:
         if check_number(self.rrt_time, "rrt_time", strict=True) > MAX_RRT_TIME:
             raise InputError(f"rrt_time: {self.rrt_time} s is over the limit {MAX_RRT_TIME} s")
         check_ipopt(self.ipopt)
+
+
+SOLVER_KEYS = frozenset(f.name for f in fields(TrajoptOptions))  # a problem file's [solver]
 
 
 @dataclass(frozen=True, eq=False)

@@ -46,6 +46,7 @@ from .assets import robot_urdf
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, UnknownNameError
 from .files import atomic_path
+from .limits import check_int, is_number
 from .robot import (
     Robot,
     RobotSpec,
@@ -123,6 +124,7 @@ MAX_OPENING = 0.085
 GRASP_GAP = 0.02  # stick end to palm (m)
 TCP = BODY_LENGTH + FINGER_LENGTH / 2  # grasp centre on the tool axis, from the flange
 GRIPPER_STATES = ("open", "closed", "holding")
+MAX_FETCH_TRIES = 1000  # fetch_scene: random layouts drawn at most
 POLYGON_GROUPS = {  # URDF link -> robot polygon (hull of the link's projected geometry)
     "base_link": "base",
     "shoulder_link": "base",
@@ -321,7 +323,7 @@ def ur5e(gripper: str = "open", stick_length: float = 0.25, stick_width: float =
         ("stick_length", stick_length, 0.02, 1.0),
         ("stick_width", stick_width, 0.005, MAX_OPENING),
     ):
-        if not isinstance(value, (int, float)) or not low <= value <= high:
+        if not is_number(value) or not low <= value <= high:
             raise InputError(f"{field_name}: expected a length in [{low}, {high}] m, got {value!r}")
     if gripper != "holding":  # one robot per state: the stick size only matters when held
         stick_length, stick_width = 0.25, 0.03
@@ -573,7 +575,7 @@ def fetch_scene(seed: int = 0, gripper: str = "open", max_tries: int = 100) -> S
 
     seed = 0 is the canonical layout (:data:`CANONICAL_FETCH`); other seeds draw random
     layouts (:func:`random_fetch_layout`), redrawn until :func:`fetch_configurations` finds
-    free grasp, home and out configurations (at most ``max_tries`` draws). ``gripper``
+    free grasp, home and out configurations (at most ``max_tries`` ≤ 1 000 draws). ``gripper``
     selects the robot: ``open``/``closed`` with the stick an obstacle, or ``holding`` it (the
     stick is then part of the robot and no obstacle).
 
@@ -586,6 +588,7 @@ def fetch_scene(seed: int = 0, gripper: str = "open", max_tries: int = 100) -> S
         raise UnknownNameError(
             f"gripper: unknown state {gripper!r}; choose one of {list(GRIPPER_STATES)}"
         )
+    check_int(max_tries, "max_tries", 1, MAX_FETCH_TRIES)
     rng = np.random.default_rng(seed)
     for _ in range(max_tries):
         layout = CANONICAL_FETCH if seed == 0 else random_fetch_layout(rng)

@@ -174,7 +174,7 @@ def test_wheel_holds_every_shipped_file(tmp_path):
     """The wheel's package data globs cover every file git ships under gdnplan/shipped/."""
     source = tmp_path / "src"  # a copy: building in the checkout would leave build/ there
     shutil.copytree(ROOT / "gdnplan", source / "gdnplan", ignore=shutil.ignore_patterns("__py*"))
-    for name in ("pyproject.toml", "README.md"):
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
         shutil.copy(ROOT / name, source / name)
     subprocess.run(
         [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(tmp_path), str(source)],

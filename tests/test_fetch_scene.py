@@ -98,8 +98,15 @@ def test_unreachable_layout_is_rejected():
 def test_fetch_errors():
     with pytest.raises(gp.UnknownNameError, match="gripper"):
         gp.make_scene("fetch", gripper="bogus")
-    with pytest.raises(gp.InfeasibleProblemError, match="max_tries"):
-        gp.make_scene("fetch", seed=5, max_tries=0)
+    for tries in (0, U.MAX_FETCH_TRIES + 1, True, 2.0):
+        with pytest.raises(gp.InputError, match="max_tries"):
+            gp.make_scene("fetch", seed=5, max_tries=tries)
+
+
+def test_fetch_gives_up_after_max_tries(monkeypatch):
+    monkeypatch.setattr(U, "fetch_configurations", lambda layout: None)  # no layout is free
+    with pytest.raises(gp.InfeasibleProblemError, match="max_tries=2"):
+        gp.make_scene("fetch", seed=5, max_tries=2)
 
 
 def test_bring_out_problem_file_carries_the_fetch_stage_solver_settings():
@@ -123,7 +130,7 @@ def test_bring_out_problem_file_plans_with_coal():
         ("[solver]\nrrt_step = 'short'", "rrt_step: expected a number"),
         ("[solver]\nccd = 1", "ccd: expected true or false"),
         ("[solver]\nstarts = 2.5", "starts: expected an integer"),
-        ("[solver]\nipopt = 1", "ipopt: expected a dict"),
+        ("[solver]\nipopt = 1", "ipopt: expected a table"),
         ("solver = 3", "expected a table"),
     ],
 )
