@@ -93,12 +93,12 @@ def problem_scene_and_start(path: Path) -> tuple[Scene, np.ndarray | None]:
     try:
         if "goal" in cfg:
             try:
-                Problem.from_config(cfg)
+                Problem.from_config(cfg, base_dir=path.parent)
             except InfeasibleProblemError:
                 pass
         _no_unknown(cfg, TOP_KEYS, "top level")
         try:
-            scene = scene_from_config(cfg)
+            scene = scene_from_config(cfg, base_dir=path.parent)
         except TypeError as e:
             raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
         start = cfg.get("start")

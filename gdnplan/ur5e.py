@@ -45,15 +45,9 @@ import pinocchio as pin
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, UnknownNameError
 from .files import atomic_path
-from .robot import (
-    ROBOTS_DIR,
-    Robot,
-    RobotSpec,
-    load_robot,
-    register_robot,
-    robot_from_models,
-)
+from .robot import ROBOTS_DIR, Robot, load_robot, register_robot
 from .scene import Scene, register_scene
+from .urdf_robot import RobotSpec, robot_from_models
 
 PI = float(np.pi)
 
