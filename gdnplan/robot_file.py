@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import InputError, ProblemFileError, UnknownNameError
-from .geometry import as_polygon, check_part, is_convex
+from .geometry import as_polygon, check_part, is_convex, min_width
 from .limits import is_number
 from .robot import Robot, robot_names
 from .urdf_robot import RobotSpec, load_urdf, robot_from_models
@@ -142,12 +142,17 @@ def _polygons(items) -> list[tuple[str, str, np.ndarray]]:
             raise ProblemFileError(f"{where} link: expected a link name, got {item['link']!r}")
         try:
             poly = as_polygon(item["polygon"], f"{where} polygon")
-            check_part(poly, f"{where} polygon")
         except InputError as e:
             raise ProblemFileError(str(e)) from e
         if not is_convex(poly):
             raise ProblemFileError(
                 f"{where} polygon: not convex; split it into several convex [[robot.polygons]]"
             )
+        try:
+            check_part(poly, f"{where} polygon")
+        except InputError as e:
+            raise ProblemFileError(
+                f"{where} polygon: only {min_width(poly):.3g} m thick; make it thicker"
+            ) from e
         out.append((f"{item['link']}_polygon{i}", item["link"], poly))
     return out

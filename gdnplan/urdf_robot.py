@@ -189,8 +189,9 @@ def plane_basis(axes) -> np.ndarray:
     if items.shape != (2, 3) or not all(is_number(x) for x in items.ravel()):
         raise InputError(f"plane: expected two 3-vectors [[ux, uy, uz], [vx, vy, vz]], got {axes}")
     u, v = np.asarray(axes, dtype=float)
-    if not np.all(np.isfinite([u, v])) or min(np.linalg.norm(u), np.linalg.norm(v)) < 1e-9:
+    if not np.all(np.isfinite([u, v])) or min(np.max(np.abs(u)), np.max(np.abs(v))) < 1e-9:
         raise InputError(f"plane: the axes {axes} must be finite, nonzero directions")
+    u, v = u / np.max(np.abs(u)), v / np.max(np.abs(v))  # no overflow in the norms
     u, v = u / np.linalg.norm(u), v / np.linalg.norm(v)
     if abs(u @ v) > PLANE_TOLERANCE:
         raise InputError(
@@ -251,6 +252,12 @@ def _reference_configuration(model: pin.Model, spec: RobotSpec, source: str) -> 
             raise InputError(f"locked: joint {jname!r} needs a finite number, got {value!r}")
         joint = model.joints[model.getJointId(jname)]
         if joint.nq == 1:
+            lo, hi = model.lowerPositionLimit[joint.idx_q], model.upperPositionLimit[joint.idx_q]
+            if not lo - 1e-9 <= value <= hi + 1e-9:
+                raise InputError(
+                    f"locked: joint {jname!r} = {value:.4g} is outside its limits "
+                    f"[{lo:.4g}, {hi:.4g}]"
+                )
             q_ref[joint.idx_q] = value
         elif joint.shortname() in CONTINUOUS:
             q_ref[joint.idx_q : joint.idx_q + 2] = np.cos(value), np.sin(value)
@@ -320,12 +327,17 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     InputError for one that does not parse, with the parser's first complaint.
     """
     path = Path(spec.urdf)
-    if not path.is_file():
-        raise UnknownNameError(f"urdf: file {path} does not exist")
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):  # a name too long, a NUL byte
+        found = False
+    if not found:
+        raise UnknownNameError(f"urdf: file {path} does not exist (or is not a file)")
     try:
         root = ET.fromstring(path.read_bytes())
     except (OSError, ET.ParseError) as e:
-        raise InputError(f"urdf: {path} is not a readable XML file ({e})") from e
+        reason = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
     rewritten = False
     for joint in root.iter("joint"):
         if joint.get("type") == "continuous" and joint.get("name") in spec.planning_joints:
@@ -355,7 +367,8 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
         else:
             return model, geom
     reason = next((line.strip() for line in log if line.strip().startswith("Error:")), "")
-    reason = reason.removeprefix("Error:").strip() or str(error)
+    reason = (reason.removeprefix("Error:").strip() or str(error) or "no reason given").strip()
+    reason = reason.splitlines()[0]
     raise InputError(f"urdf: {path} is not a valid URDF: {reason}") from error
 
 
