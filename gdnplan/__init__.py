@@ -1,5 +1,7 @@
 """gdnplan: collision-free trajectory planning with GraphDistNet, a learned collision distance."""
 
+from importlib.metadata import version as _version
+
 from . import ur5e  # noqa: F401  (registers the ur5e and ur5 robots and the fetch scene)
 from .casadi_bridge import DistanceCallback
 from .ccd import certify_path, verify_path
@@ -17,6 +19,8 @@ from .robot import Robot, load_robot, robot_names
 from .scene import Scene, make_scene, scene_names
 from .trajopt import Plan, Problem, TrajoptOptions, plan
 from .urdf_robot import RobotSpec, robot_from_urdf
+
+__version__ = _version("gdnplan")
 
 __all__ = [
     "CoalModel",

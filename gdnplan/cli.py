@@ -38,12 +38,30 @@ EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
 _DEBUG = {"on": False}  # set by ``--debug`` (the callback runs before the command)
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        from importlib.metadata import version
+
+        typer.echo(f"gdnplan {version('gdnplan')}")
+        raise typer.Exit()
+
+
 @app.callback()
 def _commands(
     debug: bool = typer.Option(False, "--debug", help="Print the traceback of any error."),
+    version: bool = typer.Option(
+        False, "--version", callback=_print_version, is_eager=True, help="Print the version."
+    ),
 ) -> None:
     """Collision-free trajectory planning with GraphDistNet."""
     _DEBUG["on"] = debug
+
+
+WEIGHTS_HELP = (
+    "GraphDistNet weights: a shipped name (d, ur5e, …) or a .safetensors file "
+    "(default: the shipped weights for the problem's robot and obstacles)."
+)
+PROBLEM_HELP = "A problem TOML file or a shipped problem's name (fetch_reach, planar7_d, …)."
 
 
 THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
@@ -74,31 +92,40 @@ def read_toml(path: Path) -> dict:
 
 
 def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
-    """A scene from a problem TOML file (with its start q) or from a generator name."""
-    if target.endswith(".toml") or (target not in scene_names() and Path(target).exists()):
-        return problem_scene_and_start(Path(target))
+    """A scene from a problem file or shipped problem name (with its start q), or from a
+    scene generator name."""
+    from .assets import problem_names
+
+    if (
+        target.endswith(".toml")
+        or target in problem_names()
+        or (target not in scene_names() and Path(target).exists())
+    ):
+        return problem_scene_and_start(target)
     return make_scene(target, seed=seed), None
 
 
-def problem_scene_and_start(path: Path) -> tuple[Scene, np.ndarray | None]:
+def problem_scene_and_start(path: str | Path) -> tuple[Scene, np.ndarray | None]:
     """The scene and ``[start] q`` of a problem file, checked as ``plan`` checks it.
 
     A file with a ``[goal]`` passes every check of :meth:`Problem.from_config` except the
     feasibility ones (a start in collision is what ``show`` draws); a scene-only file (no
     ``[goal]``, ``[start]`` optional) the checks of its tables. ProblemFileError names the file.
     """
+    from .assets import problem_file
     from .trajopt import TOP_KEYS, Problem, _no_unknown, _vector
 
     cfg = read_toml(path)
+    folder = problem_file(path).parent  # relative paths in the file ([robot] urdf) start here
     try:
         if "goal" in cfg:
             try:
-                Problem.from_config(cfg, base_dir=path.parent)
+                Problem.from_config(cfg, base_dir=folder)
             except InfeasibleProblemError:
                 pass
         _no_unknown(cfg, TOP_KEYS, "top level")
         try:
-            scene = scene_from_config(cfg, base_dir=path.parent)
+            scene = scene_from_config(cfg, base_dir=folder)
         except TypeError as e:
             raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
         start = cfg.get("start")
@@ -127,7 +154,9 @@ def check_limits(robot, q: np.ndarray, name: str) -> np.ndarray:
 
 @app.command()
 def show(
-    target: str = typer.Argument(..., help="A problem TOML file or a scene name (a-e, fetch)."),
+    target: str = typer.Argument(
+        ..., help="A problem TOML file, a shipped problem's name or a scene name (a-e, fetch)."
+    ),
     q: str = typer.Option(None, help="Joint angles 'q1,q2,...' (default: the problem's start)."),
     seed: int = typer.Option(0, min=0, help="Scene seed, for generated scenes."),
     out: Path = typer.Option(Path("scene.png"), help="Output PNG."),
@@ -150,10 +179,10 @@ def show(
 
 @app.command("plan")
 def plan_command(
-    problem_file: Path = typer.Argument(..., help="Problem TOML file (see problems/)."),
+    problem_file: str = typer.Argument(..., help=PROBLEM_HELP),
     collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
     solver: str = typer.Option("ipopt", help="ipopt (direct transcription) or adam (paper)."),
-    weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/<env>)."),
+    weights: str = typer.Option(None, help=WEIGHTS_HELP),
     seed: int = typer.Option(0, min=0, help="Seed of the sampling-based initial guesses."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
@@ -188,7 +217,7 @@ def plan_command(
         from .viz import animate_paths
 
         animate_paths(
-            [(problem.scene, result.q)], animate, title=f"{problem_file.name}: {collision}"
+            [(problem.scene, result.q)], animate, title=f"{Path(problem_file).name}: {collision}"
         )
         if not json_output:
             typer.echo(f"wrote {animate}")
@@ -376,7 +405,7 @@ def table2_command(
 def fetch_command(
     seed: int = typer.Option(0, min=0, help="Fetch layout: 0 canonical, others random storages."),
     collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
-    weights: Path = typer.Option(None, help="GraphDistNet weights (default: weights/ur5e)."),
+    weights: str = typer.Option(None, help=WEIGHTS_HELP),
     animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     threads: int = typer.Option(1, help=THREADS_HELP),
@@ -476,17 +505,21 @@ def train_command(
     out: Path = typer.Option(None, help="Weights path (default: weights/<env>.safetensors)."),
     run_dir: Path = typer.Option(None, help="Checkpoints, loss curve (default runs/<env>-<name>)."),
     compile: bool = typer.Option(False, "--compile", help="torch.compile the training step."),
-    init: Path = typer.Option(
-        None, help="Fine-tune from these GraphDistNet weights (their card's config; --set applies)."
+    init: str = typer.Option(
+        None,
+        help="Fine-tune from these GraphDistNet weights, a shipped name or a path (their "
+        "card's config; --set applies).",
     ),
     extra: list[Path] = typer.Option(
         [], help="More training shards (a directory, e.g. from generate --near); repeatable."
     ),
 ) -> None:
     """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
+    from .assets import weights_file
     from .train import check_options
 
     check_options(n_train, batch, lr, epochs, patience, time_budget, device)
+    init = None if init is None else weights_file(init)
     if out is not None:
         check_output_path(out, (".safetensors",), "--out")
         check_output_path(out.with_suffix(".json"), (".json",), "--out")

@@ -89,7 +89,7 @@ from .ur5e import GRIPPER_STATES, TABLE_V
 SHARD_SIZE = 2500
 RANDOM_ENVS = ("b", "d", "e")
 SPLITS = {"train": (0, 50_000), "test": (1, 5_000)}  # split -> (seed, paper's size)
-DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+DATA_DIR = Path("data")  # default dataset root, relative to the working directory
 FIELDS = ("q", "nodes", "obstacles", "sizes", "d", "grad", "scene_seed")
 ROBOT_FIELDS = ("gripper", "stick")  # per-sample robot variant (ur5e only)
 ENVS = (*ENV_ROBOT, "ur5e")

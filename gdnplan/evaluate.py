@@ -28,6 +28,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from scipy import stats
 
+from .assets import WEIGHTS_DIR
 from .data import DATA_DIR, SPLITS, Dataset, load, make_shard, split_dir
 from .distance import signed_distance, signed_distance_and_grad
 from .errors import InputError
@@ -275,8 +276,6 @@ def evaluate_model(
 
 
 # -------------------------------------------------------------------- Table I
-ROOT = Path(__file__).resolve().parent.parent
-WEIGHTS_DIR = ROOT / "weights"
 ENVS = ("a", "b", "c", "d", "e")
 DIFFCO_SOURCE = {"b": "a", "d": "c"}  # random env -> fixed env DiffCo is trained on (paper)
 

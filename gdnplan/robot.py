@@ -22,14 +22,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
+from .assets import robot_urdf
 from .errors import InputError, UnknownNameError
-
-ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
 
 
 def rot2(theta: np.ndarray) -> np.ndarray:
@@ -390,7 +388,7 @@ def _planar(name: str) -> Robot:
     from .urdf_robot import RobotSpec, load_urdf, robot_from_models
 
     spec = RobotSpec(
-        urdf=ROBOTS_DIR / f"{name}.urdf",
+        urdf=robot_urdf(name),
         planning_joints=tuple(f"joint{i}" for i in range(1, int(name[-1]) + 1)),
     )
     return robot_from_models(name, *load_urdf(spec), spec)

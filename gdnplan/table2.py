@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from .assets import WEIGHTS_DIR
 from .ccd import verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
@@ -45,7 +46,6 @@ from .rrt import rrt_connect
 from .scene import make_scene
 from .trajopt import Plan, Problem, TrajoptOptions, plan, straight_line
 
-WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
 SETTINGS = ("b", "d", "fetch")
 METHODS = ("GraphDistNet", "ClearanceNet", "DiffCo", "coal")
 SOLVERS = ("ipopt", "adam")

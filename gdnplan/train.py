@@ -48,9 +48,9 @@ from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
 from .models.weights import read_card, read_weights, write_weights
 
-ROOT = Path(__file__).resolve().parent.parent
-WEIGHTS_DIR = ROOT / "weights"
-RUNS_DIR = ROOT / "runs"
+SOURCE_ROOT = Path(__file__).resolve().parent.parent  # a git checkout, when not installed
+OUT_DIR = Path("weights")  # default output folder of trained weights (working directory)
+RUNS_DIR = Path("runs")  # default run folders (checkpoints, logs), working directory
 
 
 @dataclass(frozen=True)
@@ -203,9 +203,16 @@ def evaluate(net: GraphDistNet, ds: Dataset, margin: float = 0.0, device: str = 
 
 
 def git_sha() -> str:
+    """The commit of gdnplan's source checkout, or "unknown" when installed from a wheel."""
+    if not (SOURCE_ROOT / ".git").exists():
+        return "unknown"
     try:
         return subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=True
+            ["git", "rev-parse", "HEAD"],
+            cwd=SOURCE_ROOT,
+            capture_output=True,
+            text=True,
+            check=True,
         ).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
@@ -398,7 +405,7 @@ def train(
         scale=round(robot.reach, 6), origin=tuple(float(v) for v in robot.chain.joint_origins[0])
     )
     run_dir = Path(run_dir or RUNS_DIR / f"{env}-{name}")
-    out = Path(out or WEIGHTS_DIR / f"{env}.safetensors")
+    out = Path(out or OUT_DIR / f"{env}.safetensors")
     torch.manual_seed(seed)
     train_dir = split_dir(env, "train", data_root)
     full = check_env(load(train_dir, n_train), env, train_dir)

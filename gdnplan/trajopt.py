@@ -38,6 +38,7 @@ import casadi
 import numpy as np
 import pinocchio as pin
 
+from .assets import default_weights, problem_file
 from .casadi_bridge import DistanceCallback, supports_per_link
 from .ccd import Certificate, certify_path, verify_path
 from .distance import signed_distance
@@ -61,8 +62,6 @@ from .robot import Robot, first_outside
 from .rrt import seed_path
 from .scene import Scene, scene_from_config
 
-WEIGHTS_DIR = Path(__file__).resolve().parent.parent / "weights"
-WEIGHTS_FOR_SCENE = {"fetch": "ur5e"}  # scene name -> shipped weights name, where they differ
 TOP_KEYS = {"robot", "scene", "obstacles", "start", "goal", "options", "solver"}
 INITIAL_GUESSES = ("auto", "straight", "rrt")
 SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
@@ -210,10 +209,11 @@ class Problem:
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Problem:
-        """Load a problem file (schema in DESIGN.md); ProblemFileError names any bad field."""
+        """Load a problem file or a shipped problem by name (``"fetch_reach"``); the schema is
+        in docs/problem_file.md. ProblemFileError names any bad field."""
         cfg = read_problem_file(path)
         try:
-            return cls.from_config(cfg, base_dir=Path(path).parent)
+            return cls.from_config(cfg, base_dir=problem_file(path).parent)
         except ProblemFileError as e:
             raise ProblemFileError(f"{path}: {e}") from e
 
@@ -256,8 +256,11 @@ class Problem:
 
 def read_problem_file(path: str | Path) -> dict:
     """The parsed TOML mapping of a problem file; ProblemFileError when it cannot be read, is
-    not UTF-8 text, is malformed or nests deeper than Python's parser can follow."""
-    path = Path(path)
+    not UTF-8 text, is malformed or nests deeper than Python's parser can follow.
+
+    ``path``: a file, or the name of a shipped problem (``"fetch_reach"``).
+    """
+    path = problem_file(path)
     try:
         return tomllib.loads(path.read_text(encoding="utf-8"))
     except OSError as e:
@@ -530,7 +533,12 @@ def path_cost(q: np.ndarray) -> float:
 
 
 def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | Path | None):
-    """The DistanceModel named by ``collision`` ("coal", "graphdistnet" or a model instance)."""
+    """The DistanceModel named by ``collision`` ("coal", "graphdistnet" or a model instance).
+
+    ``weights`` (GraphDistNet): shipped weights by name (``"d"``) or a ``.safetensors`` path;
+    None picks the shipped weights for the scene's robot and obstacles
+    (:func:`gdnplan.assets.default_weights`).
+    """
     if not isinstance(collision, str):
         if not isinstance(collision, DistanceModel):
             raise InputError(
@@ -542,14 +550,7 @@ def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | P
         return CoalModel()
     if collision != "graphdistnet":
         raise InputError(f"collision: unknown {collision!r}; choose 'coal' or 'graphdistnet'")
-    default = WEIGHTS_DIR / f"{WEIGHTS_FOR_SCENE.get(scene.name, scene.name)}.safetensors"
-    path = Path(weights) if weights is not None else default
-    if not path.exists():
-        raise InputError(
-            f"weights: {path} does not exist; train GraphDistNet for environment "
-            f"{scene.name!r} first or pass weights=<file.safetensors>"
-        )
-    return checked(load_model(path), scene)
+    return checked(load_model(default_weights(scene) if weights is None else weights), scene)
 
 
 def checked(model: DistanceModel, scene: Scene) -> DistanceModel:

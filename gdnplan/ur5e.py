@@ -42,10 +42,11 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from .assets import robot_urdf
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, UnknownNameError
 from .files import atomic_path
-from .robot import ROBOTS_DIR, Robot, load_robot, register_robot
+from .robot import Robot, load_robot, register_robot
 from .scene import Scene, register_scene
 from .urdf_robot import RobotSpec, robot_from_models
 
@@ -279,7 +280,7 @@ def _add_stick(model: pin.Model, geom: pin.GeometryModel, length: float, width: 
 
 @lru_cache(maxsize=32)
 def _ur5e(gripper: str, stick_length: float, stick_width: float) -> Robot:
-    urdf = ROBOTS_DIR / "ur5e.urdf"
+    urdf = robot_urdf("ur5e")
     model = pin.buildModelFromUrdf(str(urdf))
     geom = pin.buildGeomFromUrdf(model, str(urdf), pin.GeometryType.COLLISION)
     half = {"open": MAX_OPENING / 2, "closed": 0.0, "holding": stick_width / 2}[gripper]

@@ -7,7 +7,7 @@ from shapely.geometry import Polygon
 
 import gdnplan as gp
 from gdnplan import ur5e as U
-from gdnplan.robot import ROBOTS_DIR
+from gdnplan.assets import ROBOTS_DIR
 
 
 def full_fk(model: pin.Model, q: np.ndarray, frame: str, base: str) -> np.ndarray:

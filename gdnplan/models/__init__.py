@@ -12,6 +12,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from ..assets import weights_file
 from ..distance import signed_distance, signed_distance_and_grad
 from ..errors import UnknownNameError
 from ..scene import Scene
@@ -50,11 +51,15 @@ class CoalModel:
         return signed_distance_and_grad(scene, q)
 
 
-def load_model(path: Path | str) -> DistanceModel:
-    """Load a trained model: ``path`` (safetensors weights) and its JSON card beside it.
+def load_model(weights: Path | str) -> DistanceModel:
+    """Load a trained model: shipped weights by name or a ``.safetensors`` file with its card.
 
-    The card's ``"model"`` field selects the class (``"graphdistnet"``, ``"clearancenet"``).
+    ``weights``: a shipped name (``"d"``, ``"ur5e"``, ``"clearancenet_b"``; see
+    :func:`gdnplan.assets.weights_names`) or a path to a ``.safetensors`` file whose JSON card
+    sits beside it. The card's ``"model"`` field selects the class (``"graphdistnet"``,
+    ``"clearancenet"``). The model refuses scenes of a robot it was not trained for.
     """
+    path = weights_file(weights)
     kind = read_card(path).get("model")
     if kind == "graphdistnet":
         from .graphdistnet import load_graphdistnet

@@ -318,7 +318,7 @@ def train_and_save(
     Returns the card (training log summary and test metrics: n, MAE (m), AUC, ACD).
     """
     from ..data import load, split_dir
-    from ..evaluate import WEIGHTS_DIR, evaluate_model
+    from ..evaluate import evaluate_model
 
     torch.set_num_threads(1)
     model = train(env, load(split_dir(env, "train")), patience=patience, time_budget=time_budget)
@@ -328,7 +328,7 @@ def train_and_save(
         f"python -m gdnplan.models.clearancenet {env} --time-budget {time_budget:g} "
         f"--patience {patience}"
     )
-    model.save(out or WEIGHTS_DIR / f"clearancenet_{env}.safetensors")
+    model.save(out or Path("weights") / f"clearancenet_{env}.safetensors")
     return model.card
 
 
