@@ -18,6 +18,7 @@ from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot, load_robot, robot_names
 from .scene import Scene, make_scene, scene_names
 from .trajopt import Plan, Problem, TrajoptOptions, plan
+from .urdf_robot import RobotSpec, robot_from_urdf
 
 __version__ = _version("gdnplan")
 
@@ -33,6 +34,7 @@ __all__ = [
     "Problem",
     "ProblemFileError",
     "Robot",
+    "RobotSpec",
     "Scene",
     "TrajoptOptions",
     "UnknownNameError",
@@ -41,6 +43,7 @@ __all__ = [
     "load_robot",
     "make_scene",
     "plan",
+    "robot_from_urdf",
     "robot_names",
     "scene_names",
     "signed_distance",

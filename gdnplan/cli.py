@@ -112,18 +112,20 @@ def problem_scene_and_start(path: str | Path) -> tuple[Scene, np.ndarray | None]
     feasibility ones (a start in collision is what ``show`` draws); a scene-only file (no
     ``[goal]``, ``[start]`` optional) the checks of its tables. ProblemFileError names the file.
     """
+    from .assets import problem_file
     from .trajopt import TOP_KEYS, Problem, _no_unknown, _vector
 
     cfg = read_toml(path)
+    folder = problem_file(path).parent  # relative paths in the file ([robot] urdf) start here
     try:
         if "goal" in cfg:
             try:
-                Problem.from_config(cfg)
+                Problem.from_config(cfg, base_dir=folder)
             except InfeasibleProblemError:
                 pass
         _no_unknown(cfg, TOP_KEYS, "top level")
         try:
-            scene = scene_from_config(cfg)
+            scene = scene_from_config(cfg, base_dir=folder)
         except TypeError as e:
             raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
         start = cfg.get("start")

@@ -13,22 +13,22 @@ where ``p⁰`` and ``o_j⁰`` are the point and joint ``j`` at ``q = 0`` (2-D pl
 
 :class:`PlanarChain` evaluates both for a batch with a handful of numpy operations; Pinocchio
 stays the reference (``Robot.node_positions_pinocchio``) and a test proves the two equal.
+Robots are built from URDF files by :mod:`gdnplan.urdf_robot` (which checks that every
+planning joint turns about ``n``); this module keeps the registry of the shipped ones.
 """
 
 from __future__ import annotations
 
 import inspect
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
 from .assets import robot_urdf
 from .errors import InputError, UnknownNameError
-from .geometry import convex_hull, simplify_convex
 
 
 def rot2(theta: np.ndarray) -> np.ndarray:
@@ -145,7 +145,8 @@ class Robot:
     """A planar-moving robot: Pinocchio model of its planning joints plus link polygons.
 
     Attributes:
-        name: registry name (``"planar2"``, ``"planar7"``, ``"ur5e"``, ``"ur5"``).
+        name: registry name (``"planar2"``, ``"planar7"``, ``"ur5e"``, ``"ur5"``) or, for a
+            robot loaded from a user's URDF, a name that is none of these.
         model: Pinocchio model reduced to the planning joints (a serial chain).
         plane: the plane the robot moves in.
         polygons: convex link polygons (the robot graph's nodes are their vertices).
@@ -349,176 +350,6 @@ def as_batch(q: np.ndarray, dof: int, name: str = "q") -> np.ndarray:
     return q
 
 
-# -------------------------------------------------------------------- building robots
-def geometry_points(geometry, samples: int = 24) -> np.ndarray:
-    """Surface points (k, 3) of a coal collision geometry in its own frame.
-
-    Boxes give their corners, cylinders/capsules/spheres rings of ``samples`` points, meshes
-    their vertices.
-    """
-    import coal
-
-    ang = np.linspace(0, 2 * np.pi, samples, endpoint=False)
-    ring = np.stack([np.cos(ang), np.sin(ang), np.zeros_like(ang)], 1)
-    if isinstance(geometry, coal.Box):
-        h = np.asarray(geometry.halfSide)
-        corners = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
-        return corners * h
-    if isinstance(geometry, coal.Sphere):
-        return _sphere_points(geometry.radius, ang)
-    if isinstance(geometry, (coal.Cylinder, coal.Capsule)):
-        r, h = geometry.radius, geometry.halfLength
-        pts = [ring * r + [0, 0, z] for z in (-h, h)]
-        if isinstance(geometry, coal.Capsule):
-            pts += [_sphere_points(r, ang) + np.array([0.0, 0.0, z]) for z in (-h, h)]
-        return np.concatenate(pts)
-    if hasattr(geometry, "vertices"):  # BVH meshes and convex hulls
-        return np.asarray(geometry.vertices())
-    if hasattr(geometry, "points"):
-        return np.asarray(geometry.points())
-    raise InputError(f"geometry: unsupported collision shape {type(geometry).__name__}")
-
-
-def _sphere_points(radius: float, ang: np.ndarray) -> np.ndarray:
-    """Points on three great circles of a sphere: enough for the hull of any projection."""
-    c, s, z = np.cos(ang), np.sin(ang), np.zeros_like(ang)
-    return radius * np.concatenate(
-        [np.stack([c, s, z], 1), np.stack([c, z, s], 1), np.stack([z, c, s], 1)]
-    )
-
-
-@dataclass(frozen=True)
-class RobotSpec:
-    """How to turn a URDF into a planar :class:`Robot`.
-
-    Attributes:
-        urdf: path of the URDF (meshes resolved from ``package_dirs``).
-        planning_joints: names of the joints that move (a serial chain, base to tip).
-        locked: values of every other joint (rad); unlisted non-planning joints lock at 0.
-        plane_axes: (2, 3) world directions of the plane coordinates u, v.
-        max_vertices: each link polygon is simplified to at most this many vertices.
-        base_radius: keep-out radius around joint 1 for generated obstacles (m).
-    """
-
-    urdf: Path
-    planning_joints: tuple[str, ...]
-    locked: dict[str, float] = field(default_factory=dict)
-    plane_axes: tuple[tuple[float, ...], tuple[float, ...]] = ((1, 0, 0), (0, 1, 0))
-    package_dirs: tuple[str, ...] = ()
-    max_vertices: int = 12
-    base_radius: float = 0.15
-
-
-def robot_from_urdf(
-    name: str,
-    spec: RobotSpec,
-    limits: tuple[np.ndarray, np.ndarray] | None = None,
-    extra_polygons: Sequence[tuple[str, str, np.ndarray]] = (),
-    skip_geometry: Callable[[str], bool] = lambda _: False,
-    info: dict | None = None,
-) -> Robot:
-    """Load a URDF with Pinocchio, lock non-planning joints and project link geometry.
-
-    Each collision geometry becomes the convex hull of its projection on the plane (simplified
-    to ``spec.max_vertices``). ``extra_polygons`` adds hand-made polygons as
-    ``(name, frame_name, vertices (m, 2) in plane coordinates at q = 0)``.
-    """
-    model, geom = _load_urdf(spec)
-    return robot_from_models(name, model, geom, spec, limits, extra_polygons, skip_geometry, info)
-
-
-def robot_from_models(
-    name: str,
-    model: pin.Model,
-    geom: pin.GeometryModel,
-    spec: RobotSpec,
-    limits: tuple[np.ndarray, np.ndarray] | None = None,
-    extra_polygons: Sequence[tuple[str, str, np.ndarray]] = (),
-    skip_geometry: Callable[[str], bool] = lambda _: False,
-    info: dict | None = None,
-    group: Callable[[str], str] | None = None,
-) -> Robot:
-    """:func:`robot_from_urdf` on an already-built full model and its collision geometry.
-
-    ``spec.urdf`` only names the source in messages and ``info``. ``group`` maps geometry
-    names to polygon names: geometries of one group (all on one body) share one polygon, the
-    convex hull of their joint projection. Without it every geometry is its own polygon.
-    """
-    q_ref = pin.neutral(model)
-    for jname, value in spec.locked.items():
-        if not model.existJointName(jname):
-            raise UnknownNameError(f"locked joint {jname!r} is not in {spec.urdf.name}")
-        q_ref[model.joints[model.getJointId(jname)].idx_q] = value
-    for jname in spec.planning_joints:
-        if not model.existJointName(jname):
-            raise UnknownNameError(f"planning joint {jname!r} is not in {spec.urdf.name}")
-    lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in spec.planning_joints]
-    reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
-    for j in range(1, reduced.njoints):
-        if reduced.parents[j] != j - 1 or reduced.joints[j].nq != 1:
-            raise InputError(f"{name}: planning joints must form a serial chain of revolute joints")
-
-    data = reduced.createData()
-    gdata = pin.GeometryData(reduced_geom)
-    q0 = np.zeros(reduced.nq)
-    pin.framesForwardKinematics(reduced, data, q0)
-    pin.updateGeometryPlacements(reduced, data, reduced_geom, gdata)
-    origin = data.oMi[1].translation.copy()
-    plane = Plane(origin=origin, axes=np.asarray(spec.plane_axes, dtype=float))
-
-    groups: dict[tuple, tuple[int, list[np.ndarray]]] = {}  # (key, name) -> (frame, points)
-    for g, obj in enumerate(reduced_geom.geometryObjects):
-        if skip_geometry(obj.name):
-            continue
-        pts = apply_se3(gdata.oMg[g], geometry_points(obj.geometry))
-        key = (g, obj.name) if group is None else (None, group(obj.name))
-        frame, clouds = groups.setdefault(key, (obj.parentFrame, []))
-        if reduced.frames[frame].parentJoint != reduced.frames[obj.parentFrame].parentJoint:
-            raise InputError(f"{name}: geometry {obj.name!r} moves apart from group {key[1]!r}")
-        clouds.append(plane.project(pts))
-    polygons = []
-    for (_, pname), (frame, clouds) in groups.items():
-        uv = simplify_convex(convex_hull(np.concatenate(clouds)), spec.max_vertices)
-        polygons.append(_attach(reduced, data, plane, pname, frame, uv))
-    for pname, frame_name, uv in extra_polygons:
-        if not reduced.existFrame(frame_name):
-            raise UnknownNameError(f"{name}: frame {frame_name!r} does not exist")
-        frame = reduced.getFrameId(frame_name)
-        polygons.append(_attach(reduced, data, plane, pname, frame, np.asarray(uv, float)))
-
-    lower = reduced.lowerPositionLimit.copy() if limits is None else np.asarray(limits[0], float)
-    upper = reduced.upperPositionLimit.copy() if limits is None else np.asarray(limits[1], float)
-    return Robot(
-        name=name,
-        model=reduced,
-        plane=plane,
-        polygons=tuple(polygons),
-        lower=lower,
-        upper=upper,
-        base_radius=spec.base_radius,
-        info=dict(info or {}, urdf=str(spec.urdf)),
-    )
-
-
-def _load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
-    if not Path(spec.urdf).exists():
-        raise UnknownNameError(f"urdf: file {spec.urdf} does not exist")
-    model = pin.buildModelFromUrdf(str(spec.urdf))
-    geom = pin.buildGeomFromUrdf(
-        model, str(spec.urdf), pin.GeometryType.COLLISION, package_dirs=list(spec.package_dirs)
-    )
-    return model, geom
-
-
-def _attach(model, data, plane: Plane, name: str, frame: int, uv: np.ndarray) -> LinkPolygon:
-    """A polygon given at q = 0 in plane coordinates, attached to a frame."""
-    joint = model.frames[frame].parentJoint
-    local = apply_se3(data.oMf[frame].inverse(), plane.lift(uv))
-    return LinkPolygon(
-        name=name, body=int(joint), frame=int(frame), vertices0=uv, vertices_frame=local
-    )
-
-
 # -------------------------------------------------------------------- registry
 _REGISTRY: dict[str, Callable[..., Robot]] = {}
 
@@ -570,11 +401,13 @@ _CACHE: dict[str, Robot] = {}
 
 
 def _planar(name: str) -> Robot:
+    from .urdf_robot import RobotSpec, load_urdf, robot_from_models
+
     spec = RobotSpec(
         urdf=robot_urdf(name),
         planning_joints=tuple(f"joint{i}" for i in range(1, int(name[-1]) + 1)),
     )
-    return robot_from_urdf(name, spec)
+    return robot_from_models(name, *load_urdf(spec), spec)
 
 
 @register_robot("planar2")

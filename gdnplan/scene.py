@@ -21,6 +21,7 @@ from __future__ import annotations
 from collections.abc import Callable, Set
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from pathlib import Path
 
 import numpy as np
 from shapely.geometry import Point, Polygon
@@ -238,11 +239,14 @@ def env_e(seed: int = 0) -> Scene:
 
 
 # -------------------------------------------------------------------- from configuration
-def scene_from_config(cfg: dict) -> Scene:
+def scene_from_config(cfg: dict, base_dir: str | Path | None = None) -> Scene:
     """Scene from a problem TOML mapping: ``[robot]``, optional ``[scene]``, ``[[obstacles]]``.
 
-    ``[robot] name`` (plus options such as ``gripper``) selects the robot; ``[scene] generator``
-    and ``seed`` draw generated obstacles; each ``[[obstacles]] polygon`` adds one polygon.
+    ``[robot] name`` (plus options such as ``gripper``) selects a shipped robot, ``[robot]
+    urdf`` (plus ``joints`` …, :mod:`gdnplan.robot_file`) loads one from a URDF file, relative
+    paths starting at ``base_dir`` (the problem file's folder; the current directory when
+    None); ``[scene] generator`` and ``seed`` draw generated obstacles; each ``[[obstacles]]
+    polygon`` adds one polygon.
     """
     robot_cfg = cfg.get("robot", {})
     scene_cfg = cfg.get("scene", {})
@@ -270,7 +274,11 @@ def scene_from_config(cfg: dict) -> Scene:
         raise ProblemFileError(
             f"[scene] generator: missing; {keys} need a generator name (e.g. d)", schema=True
         )
-    if "name" in robot_cfg:
+    if "urdf" in robot_cfg:
+        from .robot_file import robot_from_table
+
+        robot = robot_from_table(robot_cfg, base_dir)
+    elif "name" in robot_cfg:
         options = {k: v for k, v in robot_cfg.items() if k != "name"}
         if not isinstance(robot_cfg["name"], str):
             raise ProblemFileError(f"[robot] name: expected a name, got {robot_cfg['name']!r}")
@@ -282,7 +290,8 @@ def scene_from_config(cfg: dict) -> Scene:
         robot = base.robot
     else:
         raise ProblemFileError(
-            "[robot] name: missing; give a robot name (e.g. planar7)", schema=True
+            '[robot] name: missing; give a robot name (e.g. planar7) or urdf = "arm.urdf"',
+            schema=True,
         )
     extra = cfg.get("obstacles", [])
     if not isinstance(extra, list):

@@ -219,13 +219,14 @@ class Problem:
         in ``docs/problem_file.md``. ProblemFileError names any bad field."""
         cfg = read_problem_file(path)
         try:
-            return cls.from_config(cfg)
+            return cls.from_config(cfg, base_dir=problem_file(path).parent)
         except ProblemFileError as e:
             raise ProblemFileError(f"{path}: {e}") from e
 
     @classmethod
-    def from_config(cls, cfg: dict) -> Problem:
-        """Problem from a parsed TOML mapping (see :meth:`from_toml`)."""
+    def from_config(cls, cfg: dict, base_dir: str | Path | None = None) -> Problem:
+        """Problem from a parsed TOML mapping (see :meth:`from_toml`); relative paths in it
+        (``[robot] urdf``) start at ``base_dir``, the current directory when None."""
         _no_unknown(cfg, TOP_KEYS, "top level")
         for key in ("start", "goal"):
             if not isinstance(cfg.get(key), dict):
@@ -238,7 +239,7 @@ class Problem:
         _no_unknown(options, OPTION_KEYS, "[options]")
         solver = _solver_options(cfg.get("solver"))
         try:
-            scene = scene_from_config(cfg)
+            scene = scene_from_config(cfg, base_dir)
         except TypeError as e:
             raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
         goal = cfg["goal"]

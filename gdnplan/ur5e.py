@@ -47,14 +47,9 @@ from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError, UnknownNameError
 from .files import atomic_path
 from .limits import check_int, is_number
-from .robot import (
-    Robot,
-    RobotSpec,
-    load_robot,
-    register_robot,
-    robot_from_models,
-)
+from .robot import Robot, load_robot, register_robot
 from .scene import Scene, register_scene
+from .urdf_robot import RobotSpec, robot_from_models
 
 PI = float(np.pi)
 

@@ -140,7 +140,10 @@ def test_generate_then_train_writes_loadable_weights(tmp_path):
         (["train", "--env", "a", "--model", "svm"], "--model: expected"),
         (["train", "--env", "a", "--preset", "fast"], "--preset: expected"),
         (["generate", "--env", "a", "--split", "val"], "--split: expected"),
-        (["train", "--env", "a", "--init", "missing.safetensors"], "--init: no card"),
+        (
+            ["train", "--env", "a", "--init", "missing.safetensors"],
+            "--init: missing.safetensors does not exist",
+        ),
         (["train", "--env", "a", "--compile", "--set", "grad_weight=0.1"], "double backward"),
     ],
 )

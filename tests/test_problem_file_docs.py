@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import re
+import shutil
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +30,7 @@ from gdnplan import scene as scene_module
 from gdnplan.errors import SCHEMA_DOC
 from gdnplan.limits import IPOPT_OPTIONS
 from gdnplan.robot import robot_names, robot_options
+from gdnplan.robot_file import DEFAULT_PLANE, URDF_KEYS
 from gdnplan.scene import OBSTACLE_KEYS, ROBOT_KEYS, SCENE_KEYS, scene_names, scene_options
 from gdnplan.trajopt import (
     GOAL_KEYS,
@@ -38,16 +40,21 @@ from gdnplan.trajopt import (
     TOP_KEYS,
     read_problem_file,
 )
+from gdnplan.urdf_robot import RobotSpec
 
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / SCHEMA_DOC
-HEADING = re.compile(r'^#{2,3} `(\[\[?[a-z_.]+\]\]?)`(?: with `(name|generator) = "(\w+)"`)?\s*$')
+HEADING = re.compile(
+    r'^#{2,3} `(\[\[?[a-z_.]+\]\]?)`(?: with `(name|generator) = "(\w+)"`| with `(urdf)`)?\s*$'
+)
 COLUMNS = ["key", "type", "default", "unit", "meaning", "example", "refused"]
 BASE = ROOT / "problems" / "planar2_square.toml"  # the context of every example ...
 BASES = {  # ... but these sections'
     ("robot", "ur5e"): ROOT / "problems" / "fetch_bring_out.toml",
     ("scene", "fetch"): ROOT / "problems" / "fetch_bring_out.toml",
+    ("robot", "urdf"): ROOT / "examples" / "three_link_arm.toml",  # its URDF is copied beside
 }
+USER_URDF = ROOT / "examples" / "three_link_arm.urdf"
 Section = tuple[str, str | None]  # (table, robot or generator name the rows belong to)
 
 
@@ -74,7 +81,7 @@ def doc_rows() -> list[Row]:
     for number, line in enumerate(DOC.read_text(encoding="utf-8").splitlines(), 1):
         if line.startswith("#"):
             m = HEADING.match(line)
-            section = (m[1].strip("[]"), m[3]) if m else None
+            section = (m[1].strip("[]"), m[3] or m[4]) if m else None
         elif section is not None and line.startswith("| `"):
             cells = [c.strip() for c in line.strip().strip("|").split("|")]
             assert len(cells) == len(COLUMNS), f"{DOC.name}:{number}: expected {COLUMNS}"
@@ -97,6 +104,7 @@ def parser_keys() -> dict[Section, set[str]]:
         ("solver.ipopt", None): set(IPOPT_OPTIONS),
     }
     keys |= {("robot", n): robot_options(n) for n in robot_names() if robot_options(n)}
+    keys[("robot", "urdf")] = set(URDF_KEYS)
     keys |= {("scene", n): scene_options(n) for n in scene_names() if scene_options(n)}
     return keys
 
@@ -136,6 +144,11 @@ def parser_default(row: Row):
         return {f.name: f.default for f in dataclasses.fields(gp.Problem)}[row.key]
     if table == "solver":
         return getattr(gp.TrajoptOptions(), row.key)
+    if (table, name) == ("robot", "urdf"):
+        spec = {f.name: f.default for f in dataclasses.fields(RobotSpec)}
+        defaults = {"plane": [list(axis) for axis in DEFAULT_PLANE]}
+        defaults |= {k: spec[k] for k in ("max_vertices", "base_radius")}
+        return defaults.get(row.key, inspect.Parameter.empty)
     factory = None
     if table == "robot" and name is not None:
         factory = robot_module._REGISTRY[name]
@@ -184,6 +197,8 @@ def load_with(row: Row, line: dict, tmp_path: Path) -> gp.Problem:
         cfg.setdefault(table, {}).update(line)
     path = tmp_path / "problem.toml"
     path.write_text(tomli_w.dumps(cfg), encoding="utf-8")
+    if row.section == ("robot", "urdf"):
+        shutil.copy(USER_URDF, tmp_path)
     return gp.Problem.from_toml(path)
 
 
@@ -217,8 +232,8 @@ def test_example_is_accepted(row, tmp_path):
     line = snippet(row.example, row)
     problem = load_with(row, line, tmp_path)
     value = line[row.key]
-    if (row.section[0], row.key) in UNSEEN:
-        return
+    if (row.section[0], row.key) in UNSEEN or row.section == ("robot", "urdf"):
+        return  # a URDF robot keeps no table of its keys: loading it is the check
     if row.section[0] == "obstacles":
         value = sorted(map(tuple, value))
     got = reached(row, problem)

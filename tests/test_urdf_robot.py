@@ -1,0 +1,309 @@
+"""Robots from URDF files: the user arm's kinematics, and every refusal of a robot that cannot
+be planned in its plane (missing or broken URDF, unknown, prismatic, branched or tilted
+joints, degenerate plane axes, nothing to collide with)."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import gdnplan as gp
+from gdnplan.errors import InputError, UnknownNameError
+from gdnplan.urdf_robot import AXIS_TOLERANCE, RobotSpec, plane_basis, robot_from_urdf
+
+ROOT = Path(__file__).resolve().parent.parent
+ARM = ROOT / "examples" / "three_link_arm.urdf"
+ARM_JOINTS = ("shoulder", "elbow", "wrist")
+LIMIT = '<limit lower="-3" upper="3" effort="1" velocity="1"/>'
+
+
+def link(name: str, length: float = 0.4, width: float = 0.05) -> str:
+    box = f'<box size="{length} {width} {width}"/>'
+    geometry = f'<collision><origin xyz="{length / 2} 0 0"/><geometry>{box}</geometry></collision>'
+    return f'<link name="{name}">{geometry}</link>'
+
+
+def joint(name, parent, child, kind="revolute", xyz="0 0 0", rpy="0 0 0", axis="0 0 1") -> str:
+    limit = LIMIT if kind in ("revolute", "prismatic") else ""
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>{limit}</joint>'
+    )
+
+
+def write_urdf(folder: Path, *parts: str, name: str = "test_arm") -> Path:
+    path = folder / f"{name}.urdf"
+    path.write_text(f'<?xml version="1.0"?><robot name="{name}">{"".join(parts)}</robot>')
+    return path
+
+
+def two_link(folder: Path, kind2: str = "revolute", axis2: str = "0 0 1") -> Path:
+    return write_urdf(
+        folder,
+        '<link name="base"/>',
+        joint("j1", "base", "l1"),
+        link("l1"),
+        joint("j2", "l1", "l2", kind=kind2, xyz="0.4 0 0", axis=axis2),
+        link("l2"),
+    )
+
+
+def arm_spec(**changes) -> RobotSpec:
+    base = {"urdf": ARM, "planning_joints": ARM_JOINTS, "locked": {"tool_roll": np.pi / 2}}
+    return RobotSpec(**{**base, **changes})
+
+
+# -------------------------------------------------------------------- the user arm
+def test_user_arm_kinematics_equal_pinocchio():
+    arm = gp.robot_from_urdf("arm", arm_spec())
+    assert arm.name == "arm" and arm.joint_names == list(ARM_JOINTS)
+    q = arm.sample(20, seed=3)
+    np.testing.assert_allclose(arm.node_positions(q), arm.node_positions_pinocchio(q), atol=1e-12)
+    np.testing.assert_allclose(arm.node_jacobians(q), arm.node_jacobians_pinocchio(q), atol=1e-12)
+
+
+def test_continuous_wrist_is_planned_within_pi_and_locked_roll_flattens_the_tool():
+    arm = gp.robot_from_urdf("arm", arm_spec())
+    assert arm.lower[2] == pytest.approx(-np.pi) and arm.upper[2] == pytest.approx(np.pi)
+    tool = next(p for p in arm.polygons if p.name.startswith("tool"))
+    width = np.ptp(tool.vertices0[:, 1])
+    assert width == pytest.approx(0.02, abs=1e-6)  # rolled by π/2: the 0.02 m side in plane
+    unrolled = gp.robot_from_urdf("arm", arm_spec(locked={}))
+    tool0 = next(p for p in unrolled.polygons if p.name.startswith("tool"))
+    assert np.ptp(tool0.vertices0[:, 1]) == pytest.approx(0.08, abs=1e-6)
+
+
+def test_public_api():
+    assert gp.RobotSpec is RobotSpec and gp.robot_from_urdf is robot_from_urdf
+
+
+@pytest.mark.parametrize("name", ["planar2", "ur5e", "", 3])
+def test_shipped_or_empty_names_are_refused(name):
+    with pytest.raises(InputError, match="name"):
+        gp.robot_from_urdf(name, arm_spec())
+
+
+# -------------------------------------------------------------------- broken files
+def test_missing_urdf(tmp_path):
+    with pytest.raises(UnknownNameError, match=r"nope\.urdf does not exist"):
+        gp.robot_from_urdf("arm", arm_spec(urdf=tmp_path / "nope.urdf"))
+
+
+@pytest.mark.parametrize(
+    ("text", "reason"),
+    [
+        ("this is not xml", "not a readable XML file"),
+        ("", "not a readable XML file"),
+        ('<robot name="x"><link name="a"/>' + joint("j", "a", "b", "revolute")[:-8], "XML"),
+        (  # valid XML, invalid URDF: urdfdom's own complaint becomes the message
+            '<robot name="x"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+            '<parent link="a"/><child link="b"/></joint></robot>',
+            "does not specify limits",
+        ),
+    ],
+)
+def test_garbage_urdf_is_one_input_error(tmp_path, capfd, text, reason):
+    path = tmp_path / "bad.urdf"
+    path.write_text(text)
+    with pytest.raises(InputError, match=reason) as info:
+        gp.robot_from_urdf("arm", arm_spec(urdf=path))
+    assert "\n" not in str(info.value) and str(path) in str(info.value)
+    assert "Error" not in capfd.readouterr().err  # urdfdom's stderr lines are captured
+
+
+# -------------------------------------------------------------------- joints
+def test_unknown_planning_joint_lists_the_joints():
+    with pytest.raises(UnknownNameError, match=r"'knee' is not in three_link_arm\.urdf.*'elbow'"):
+        gp.robot_from_urdf("arm", arm_spec(planning_joints=("shoulder", "knee")))
+
+
+def test_unknown_locked_joint():
+    with pytest.raises(UnknownNameError, match="locked: joint 'roll'"):
+        gp.robot_from_urdf("arm", arm_spec(locked={"roll": 0.0}))
+
+
+def test_a_joint_both_planned_and_locked():
+    with pytest.raises(InputError, match="'wrist' is a planning joint"):
+        gp.robot_from_urdf("arm", arm_spec(locked={"wrist": 0.0}))
+
+
+def test_prismatic_planning_joint_is_named(tmp_path):
+    spec = RobotSpec(urdf=two_link(tmp_path, kind2="prismatic"), planning_joints=("j1", "j2"))
+    with pytest.raises(InputError, match="'j2' is prismatic"):
+        gp.robot_from_urdf("arm", spec)
+
+
+def test_branched_joints_are_not_a_serial_chain(tmp_path):
+    path = write_urdf(
+        tmp_path,
+        '<link name="base"/>',
+        joint("j1", "base", "l1"),
+        link("l1"),
+        joint("j2", "base", "l2", xyz="0 0.3 0"),  # a sibling of j1, not its child
+        link("l2"),
+    )
+    with pytest.raises(InputError, match=r"'j2' does not hang from 'j1'.*serial chain"):
+        gp.robot_from_urdf("arm", RobotSpec(urdf=path, planning_joints=("j1", "j2")))
+
+
+def test_planning_joints_listed_tip_first_are_refused():
+    with pytest.raises(InputError, match="base to tip"):
+        gp.robot_from_urdf("arm", arm_spec(planning_joints=("elbow", "shoulder", "wrist")))
+
+
+def test_joint_axis_in_the_plane_is_named(tmp_path):
+    spec = RobotSpec(urdf=two_link(tmp_path, axis2="0 1 0"), planning_joints=("j1", "j2"))
+    with pytest.raises(InputError, match="planning joint 'j2' turns about the world axis"):
+        gp.robot_from_urdf("arm", spec)
+
+
+def test_ur5_with_the_default_plane_is_refused_naming_shoulder_lift():
+    """The class of bug: UR5's lift joints turn about world y; in the default x–y plane they
+    would move nothing, and the robot used to load."""
+    example_robot_data = pytest.importorskip("example_robot_data")
+    from gdnplan.ur5e import PLANNING_JOINTS
+
+    urdf = Path(example_robot_data.load("ur5").urdf)
+    spec = RobotSpec(urdf=urdf, planning_joints=PLANNING_JOINTS)
+    with pytest.raises(InputError, match="planning joint 'shoulder_lift_joint' turns about"):
+        gp.robot_from_urdf("my_ur5", spec)
+    # the plane of the shipped ur5 (x–z) is accepted, from the file (meshes via package://)
+    robot = gp.robot_from_urdf(
+        "my_ur5",
+        RobotSpec(
+            urdf=urdf,
+            planning_joints=PLANNING_JOINTS,
+            locked={"wrist_2_joint": np.pi / 2},
+            plane_axes=((1, 0, 0), (0, 0, 1)),
+        ),
+    )
+    assert robot.dof == 3 and robot.n_links > 0
+
+
+@pytest.mark.parametrize("name", ["planar2", "planar7", "ur5e", "ur5"])
+def test_shipped_robots_turn_about_their_plane_normal(name):
+    robot = gp.load_robot(name)
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, np.zeros(robot.dof))
+    for j in range(1, robot.dof + 1):
+        z = (
+            data.oMi[j].rotation
+            @ np.eye(3)[
+                ["JointModelRX", "JointModelRY", "JointModelRZ"].index(
+                    robot.model.joints[j].shortname()
+                )
+            ]
+        )
+        assert abs(abs(z @ robot.plane.normal) - 1) < 1e-12
+
+
+# -------------------------------------------------------------------- plane and geometry
+@pytest.mark.parametrize(
+    ("axes", "message"),
+    [
+        (((1, 0, 0), (1, 0, 0)), "not perpendicular"),
+        (((1, 0, 0), (1, 1, 0)), "not perpendicular"),
+        (((1, 0, 0), (0, 0, 0)), "nonzero"),
+        (((1, 0, 0), (0, float("nan"), 1)), "finite"),
+        (((1, 0, 0),), "two 3-vectors"),
+        (((1, 0), (0, 1)), "two 3-vectors"),
+        ((("x", 0, 0), (0, 1, 0)), "two 3-vectors"),
+        (((True, 0, 0), (0, 1, 0)), "two 3-vectors"),
+    ],
+)
+def test_degenerate_plane_axes(axes, message):
+    with pytest.raises(InputError, match=f"plane: .*{message}"):
+        gp.robot_from_urdf("arm", arm_spec(plane_axes=axes))
+
+
+def test_plane_basis_is_orthonormal_and_keeps_u():
+    basis = plane_basis(((2, 0, 0), (0.0005, 3, 0)))
+    np.testing.assert_allclose(basis @ basis.T, np.eye(2), atol=1e-15)
+    np.testing.assert_allclose(basis[0], (1, 0, 0))
+
+
+def test_no_geometry_and_no_polygons(tmp_path):
+    path = write_urdf(
+        tmp_path, '<link name="base"/>', joint("j1", "base", "l1"), '<link name="l1"/>'
+    )
+    with pytest.raises(InputError, match="no collision geometry"):
+        gp.robot_from_urdf("arm", RobotSpec(urdf=path, planning_joints=("j1",)))
+    square = np.array([[0.1, -0.02], [0.3, -0.02], [0.3, 0.02], [0.1, 0.02]])
+    robot = gp.robot_from_urdf(
+        "arm", RobotSpec(urdf=path, planning_joints=("j1",)), extra_polygons=[("p", "l1", square)]
+    )
+    assert robot.n_links == 1 and robot.polygons[0].body == 1
+
+
+def test_geometry_flat_in_the_plane_is_refused(tmp_path):
+    flat = '<collision><geometry><box size="0.4 0 0.05"/></geometry></collision>'
+    path = write_urdf(
+        tmp_path, '<link name="base"/>', joint("j1", "base", "l1"), f'<link name="l1">{flat}</link>'
+    )
+    with pytest.raises(InputError, match=r"'l1_0' of test_arm\.urdf projects to a segment"):
+        gp.robot_from_urdf("arm", RobotSpec(urdf=path, planning_joints=("j1",)))
+
+
+@pytest.mark.parametrize(("field", "value"), [("max_vertices", 2), ("base_radius", -0.1)])
+def test_bad_spec_numbers(field, value):
+    with pytest.raises(InputError, match=field):
+        gp.robot_from_urdf("arm", arm_spec(**{field: value}))
+
+
+# -------------------------------------------------------------------- any plane orientation
+def rotation(rpy) -> np.ndarray:
+    return pin.rpy.rpyToMatrix(*rpy)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    rpy=st.tuples(*[st.floats(-np.pi, np.pi)] * 3),
+    lengths=st.tuples(st.floats(0.1, 1.0), st.floats(0.1, 1.0)),
+    tilt=st.floats(10 * AXIS_TOLERANCE, 1.0),
+)
+def test_arm_in_any_plane_is_accepted_and_a_tilted_plane_refused(rpy, lengths, tilt):
+    """A two-link arm mounted with any rotation R (a fixed joint): plane axes R x, R y are
+    accepted and its chain equals Pinocchio; the plane tilted by more than the tolerance about
+    u is refused naming joint j1; tilted by far less, accepted."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = write_urdf(
+            Path(folder),
+            '<link name="world"/>',
+            joint(
+                "mount",
+                "world",
+                "base",
+                kind="fixed",
+                xyz="0.1 -0.2 0.3",
+                rpy=" ".join(repr(a) for a in rpy),
+            ),
+            '<link name="base"/>',
+            joint("j1", "base", "l1"),
+            link("l1", lengths[0]),
+            joint("j2", "l1", "l2", xyz=f"{lengths[0]} 0 0"),
+            link("l2", lengths[1]),
+        )
+        r = rotation(rpy)
+        spec = RobotSpec(urdf=path, planning_joints=("j1", "j2"), plane_axes=(r[:, 0], r[:, 1]))
+        robot = gp.robot_from_urdf("arm", spec)
+        q = robot.sample(5, seed=0)
+        np.testing.assert_allclose(
+            robot.node_positions(q), robot.node_positions_pinocchio(q), atol=1e-10
+        )
+        assert robot.reach == pytest.approx(sum(lengths), abs=1e-9 + 0.03)
+        c, s = np.cos(tilt), np.sin(tilt)
+        tilted = (r[:, 0], c * r[:, 1] + s * r[:, 2])
+        with pytest.raises(InputError, match="planning joint 'j1' turns about"):
+            gp.robot_from_urdf(
+                "arm", RobotSpec(urdf=path, planning_joints=("j1", "j2"), plane_axes=tilted)
+            )
+        slight = (r[:, 0], np.cos(1e-9) * r[:, 1] + np.sin(1e-9) * r[:, 2])
+        gp.robot_from_urdf(
+            "arm", RobotSpec(urdf=path, planning_joints=("j1", "j2"), plane_axes=slight)
+        )
