@@ -1,7 +1,7 @@
 """Time parametrisation of a certified joint path under velocity and acceleration limits.
 
 The planner certifies the piecewise-linear path through its waypoints q_0 … q_{T−1} (rad)
-(:func:`gdnplan.ccd.certify_path`). :func:`time_path` gives it times t_0 = 0 < … < t_{T−1} (s)
+(:func:`gdnplan.ccd.certify_path`). :func:`time_path` gives it times 0 = t_0 ≤ … ≤ t_{T−1} (s)
 in one of three ways, each of them along a path that is certified collision-free:
 
 ``linear`` (velocity limits v only, the default): the exact waypoint polygon at constant speed,
@@ -9,23 +9,21 @@ in one of three ways, each of them along a path that is certified collision-free
     |q̇_j| ≤ v_j; the velocity jumps at the waypoints (unbounded acceleration there).
 ``smooth`` (acceleration limits a given, and a scene): the shape-preserving cubic (PCHIP) p(s)
     through the waypoints, s the cumulative chord length (rad), time-parametrised by toppra
-    (time-optimal, reachability analysis) under |ṗ_j(s) ṡ| ≤ v_j and
+    (time-optimal, reachability analysis) under |p'_j(s) ṡ| ≤ v_j and
     |p''_j(s) ṡ² + p'_j(s) s̈| ≤ a_j, at rest at both ends. toppra enforces the limits at its grid
     points (:data:`GRID_PER_SEGMENT` per segment, plus one just before every waypoint, where p''
     jumps); the time axis is then stretched by c ≥ 1 so that the limits hold at
     :data:`CHECKS_PER_CELL` points per grid cell with ``STRETCH_SLACK`` to spare (velocities
     scale by 1/c, accelerations by 1/c²).
-    The curve leaves the polygon, so it gets its own certificate (:func:`certify_curve`).
+    The curve leaves the polygon, so it gets its own certificate (:mod:`gdnplan.ccd_curve`).
 ``stop`` (acceleration limits, no scene or the smooth curve not certified): the exact polygon,
     at rest at every waypoint, each segment the time-optimal trapezoidal (or triangular) profile
     of σ ∈ [0, 1] under σ̇ ≤ min_j v_j / |Δq_j| and |σ̈| ≤ min_j a_j / |Δq_j|. A polygon
     with corners cannot be followed exactly at bounded acceleration without stopping at them.
 
-The curve certificate. Bound (1) of :mod:`gdnplan.ccd` uses only that no robot point moves
-farther than δ = Σ_j r_{l,j} ∫|q̇_j| along a piece; for a straight piece ∫|q̇_j| = |Δq_j|, for
-a cubic piece it is the total variation TV_j of p_j over the piece (exact, from the roots of
-the quadratic p'_j). So every curve piece [s_a, s_b] with (d̲(p(s_a)) + d̲(p(s_b)) − δ) / 2 > 0
-is proven free; :func:`certify_curve` bisects in s until all pieces are.
+The curve certificate (:mod:`gdnplan.ccd_curve`) is the planner's (bound (1) of
+:mod:`gdnplan.ccd`) with each joint's straight travel |Δq_j| replaced by the cubic's exact total
+variation over the piece.
 """
 
 from __future__ import annotations
@@ -35,8 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .ccd import MIN_PIECE, lever_arms, proven_distance
-from .distance import signed_distance
+from .ccd_curve import certify_curve
 from .errors import InputError
 from .limits import MAX_TIMED_SAMPLES, check_number, is_number
 from .robot import Robot
@@ -46,8 +43,6 @@ GRID_PER_SEGMENT = 8  # toppra grid cells per waypoint segment (fewer above MAX_
 MAX_GRID = 4000  # toppra grid points at most
 CHECKS_PER_CELL = 8  # limit checks per toppra grid cell (the time stretch c)
 STRETCH_SLACK = 1e-3  # c is raised by this fraction (the limits hold between the checks too)
-CURVE_SPLITS = 4  # curve certificate: pieces each segment starts with
-CURVE_MAX_CHECKS = 200_000  # curve certificate: coal evaluations allowed
 KINDS = ("linear", "smooth", "stop")
 
 
@@ -277,76 +272,6 @@ def _toppra(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> _Smooth |
     return prof
 
 
-def _total_variation(curve, sa: np.ndarray, sb: np.ndarray) -> np.ndarray:
-    """(N, dof) exact ∫|p'_j| ds of the cubic PPoly ``curve`` over pieces [sa, sb] (N,), each
-    inside one polynomial interval: |Δp| between the ends and the roots of the quadratic p'_j."""
-    cell = np.clip(np.searchsorted(curve.x, sa, side="right") - 1, 0, len(curve.x) - 2)
-    c = curve.c[:, cell]  # (4, N, dof): p = c0 x³ + c1 x² + c2 x + c3, x = s − x_cell
-    xa, xb = (sa - curve.x[cell])[:, None], (sb - curve.x[cell])[:, None]
-    qa, qb = 3 * c[0], 2 * c[1]  # p' = qa x² + qb x + c2
-    disc = np.maximum(qb**2 - 4 * qa * c[2], 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lin = np.where(qb != 0, -c[2] / qb, np.nan)
-        r1 = np.where(qa != 0, (-qb - np.sqrt(disc)) / (2 * qa), lin)
-        r2 = np.where(qa != 0, (-qb + np.sqrt(disc)) / (2 * qa), np.nan)
-    pts = np.stack([np.broadcast_to(xa, r1.shape), r1, r2, np.broadcast_to(xb, r1.shape)])
-    pts = np.where(np.isfinite(pts) & (pts >= xa) & (pts <= xb), pts, xa)
-    pts = np.sort(pts, axis=0)
-    val = ((c[0] * pts + c[1]) * pts + c[2]) * pts + c[3]
-    return np.sum(np.abs(np.diff(val, axis=0)), axis=0)
-
-
-@dataclass(frozen=True)
-class CurveCertificate:
-    """Result of :func:`certify_curve`: ``ok`` proves coal distance > margin on the whole curve;
-    ``lower_bound`` the proven bound (m, −inf unless ok); ``n_checks`` coal evaluations."""
-
-    ok: bool
-    lower_bound: float
-    n_checks: int
-
-
-def certify_curve(
-    scene: Scene,
-    curve,
-    margin: float = 0.0,
-    tol: float = 1e-3,
-    splits: int = CURVE_SPLITS,
-    max_checks: int = CURVE_MAX_CHECKS,
-) -> CurveCertificate:
-    """Prove the cubic PPoly joint curve p(s), s ∈ [curve.x[0], curve.x[-1]], keeps the coal
-    distance above ``margin`` (m): bound (1) of :mod:`gdnplan.ccd` with δ = max_l Σ_j r_{l,j}
-    TV_j on every piece, pieces bisected in s (never across a knot) until all are proven and
-    their bounds within ``tol`` (m) of the smallest checked distance."""
-    robot, arms = scene.robot, lever_arms(scene.robot)
-    x = curve.x
-    s = np.linspace(0.0, 1.0, splits + 1)
-    nodes = np.unique((x[:-1, None] + s[None] * np.diff(x)[:, None]).ravel())
-    nodes = np.unique(np.concatenate([nodes, x]))
-    d = proven_distance(signed_distance(scene, robot.check_q(curve(nodes), "curve")))
-    sa, sb, da, db = nodes[:-1], nodes[1:], d[:-1], d[1:]
-    n_checks, lower, best = len(nodes), math.inf, float(np.min(d))
-    while len(sa):
-        if np.any(da <= margin) or np.any(db <= margin):
-            return CurveCertificate(False, -math.inf, n_checks)
-        delta = np.max(_total_variation(curve, sa, sb) @ arms.T, axis=1)
-        bound = (da + db - delta) / 2
-        proven = (bound > margin) & (bound >= best - tol)
-        if proven.any():
-            lower = min(lower, float(np.min(bound[proven])))
-        keep = ~proven
-        if np.any(keep & (delta < MIN_PIECE)) or n_checks + int(keep.sum()) > max_checks:
-            return CurveCertificate(False, -math.inf, n_checks)
-        sa, sb, da, db = sa[keep], sb[keep], da[keep], db[keep]
-        mid = (sa + sb) / 2
-        dm = proven_distance(signed_distance(scene, curve(mid))) if len(mid) else mid
-        n_checks += len(mid)
-        best = min(best, float(np.min(dm))) if len(dm) else best
-        sa, sb = np.concatenate([sa, mid]), np.concatenate([mid, sb])
-        da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
-    return CurveCertificate(True, lower, n_checks)
-
-
 def time_path(
     q: np.ndarray,
     max_velocity,
@@ -404,9 +329,7 @@ def plan_timing(
 
 
 __all__ = [
-    "CurveCertificate",
     "TimedTrajectory",
-    "certify_curve",
     "limit_vector",
     "plan_timing",
     "time_path",
