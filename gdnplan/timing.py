@@ -227,10 +227,16 @@ def _toppra(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> _Smooth |
     """toppra's time-optimal s(t) on ``curve``; None when toppra finds no parametrisation."""
     import logging
 
-    import toppra
-    import toppra.algorithm
-    import toppra.constraint as tc
-    from toppra.algorithm.algorithm import ParameterizationReturnCode
+    try:
+        import toppra
+        import toppra.algorithm
+        import toppra.constraint as tc
+        from toppra.algorithm.algorithm import ParameterizationReturnCode
+    except ImportError as e:  # PyPI has toppra wheels for Linux x86-64 only
+        raise InputError(
+            f"max_acceleration: the smooth timing needs toppra ({e}); pip install toppra, "
+            "or time the plan without max_acceleration"
+        ) from e
 
     logging.getLogger("toppra").setLevel(logging.ERROR)
     segments = len(knots) - 1

@@ -278,3 +278,11 @@ def test_scripted_fetch_stages_carry_times():
     assert summary["joint_names"] == ["shoulder_lift_joint", "elbow_joint", "wrist_1_joint"]
     t = np.array(summary["t"])
     assert len(t) == len(summary["q"]) and t[0] == 0 and np.all(np.diff(t) > 0)
+
+
+def test_smooth_timing_without_toppra_says_how_to_install_it(free, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "toppra", None)  # import toppra raises ImportError
+    with pytest.raises(gp.InputError, match="pip install toppra"):
+        time_path(np.array([[0.0, 0.0], [0.5, 0.2]]), 1.0, 2.0, free[2])
