@@ -83,8 +83,11 @@ def motion_bound(
 
 
 def proven_distance(d_coal: np.ndarray) -> np.ndarray:
-    """Lower bound d̲ = d_coal − COAL_SLACK (1 + |d_coal|) on the exact distance (m)."""
-    return d_coal - COAL_SLACK * (1.0 + np.abs(d_coal))
+    """Lower bound d̲ = d_coal − COAL_SLACK (1 + |d_coal|) on the exact distance (m); +inf (no
+    obstacles) stays +inf."""
+    d_coal = np.asarray(d_coal, float)
+    finite = np.where(np.isposinf(d_coal), 0.0, d_coal)
+    return np.where(np.isposinf(d_coal), np.inf, finite - COAL_SLACK * (1.0 + np.abs(finite)))
 
 
 @dataclass(frozen=True)

@@ -188,6 +188,9 @@ def plan_command(
     animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
     threads: int = typer.Option(1, help=THREADS_HELP),
     view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
+    max_acceleration: float = typer.Option(
+        None, help="Joint acceleration limit (rad/s²) of the timing; default: velocity only."
+    ),
 ) -> None:
     """Plan a collision-free trajectory; success is certified by a dense coal check.
 
@@ -203,15 +206,23 @@ def plan_command(
 
         require_meshcat()
     problem = Problem.from_toml(problem_file)
-    result = plan(problem, collision=collision, solver=solver, weights=weights, seed=seed)
+    result = plan(
+        problem,
+        collision=collision,
+        solver=solver,
+        weights=weights,
+        seed=seed,
+        max_acceleration=max_acceleration,
+    )
     if json_output:
-        typer.echo(json.dumps(plan_summary(result)))
+        typer.echo(json.dumps(plan_summary(result, problem.scene.robot.joint_names)))
     else:
         verdict = "certified collision-free" if result.success else f"FAILED ({result.reason})"
+        timed = "" if result.duration is None else f", duration {result.duration:.2f} s"
         typer.echo(
             f"{problem_file}: {verdict}; {clearance_text(result.min_distance)}, "
             f"solve time {result.solve_time:.2f} s, {result.iterations} iterations, "
-            f"path cost {result.path_cost:.3f}"
+            f"path cost {result.path_cost:.3f}{timed}"
         )
     if animate is not None:
         from .viz import animate_paths
@@ -241,11 +252,20 @@ def json_number(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
 
-def plan_summary(result) -> dict:
-    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none)."""
+def plan_summary(result, joint_names: list[str]) -> dict:
+    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none).
+
+    ``t`` (s) is the time of each row of ``q`` (rad, columns in ``joint_names`` order), and
+    ``timing`` its kind (:mod:`gdnplan.timing`); both null when the plan has no trajectory.
+    """
+    traj = result.trajectory
     return {
         "success": bool(result.success),
+        "joint_names": list(joint_names),
         "q": np.asarray(result.q).tolist(),
+        "t": None if traj is None else traj.times.tolist(),
+        "duration": None if traj is None else traj.duration,
+        "timing": None if traj is None else traj.kind,
         "min_distance": json_number(result.min_distance),
         "sampled_min_distance": json_number(result.sampled_min_distance),
         "solve_time": float(result.solve_time),

@@ -35,6 +35,7 @@ from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
 from .models import DistanceModel
 from .scene import Scene, make_scene
+from .timing import time_path, urdf_velocity
 from .trajopt import Plan, Problem, TrajoptOptions, plan
 from .ur5e import LIFT, solve_ik
 
@@ -65,6 +66,9 @@ class Stage:
         solve_time: wall time of the stage (s).
         planned: True when solved by :func:`~gdnplan.trajopt.plan`.
         detail: the planner's reason, or what a scripted stage did.
+        times: (T,) time of each row of q from the stage's start (s): the plan's
+            (:attr:`~gdnplan.trajopt.Plan.times`) or, scripted, the URDF velocity limits along
+            the path (grasp: 0, 0); None for a failed planned stage.
     """
 
     name: str
@@ -75,9 +79,10 @@ class Stage:
     solve_time: float
     planned: bool
     detail: str
+    times: np.ndarray | None = None
 
     def summary(self) -> dict:
-        """JSON-ready summary (q as lists)."""
+        """JSON-ready summary (q as lists, t the times of its rows or null)."""
         return {
             "stage": self.name,
             "gripper": self.scene.robot.info["gripper"],
@@ -86,7 +91,9 @@ class Stage:
             "solve_time": float(self.solve_time),
             "planned": self.planned,
             "detail": self.detail,
+            "joint_names": self.scene.robot.joint_names,
             "q": np.asarray(self.q).tolist(),
+            "t": None if self.times is None else np.asarray(self.times).tolist(),
         }
 
 
@@ -135,7 +142,13 @@ def _planned(
 ) -> Stage:
     """Solve one stage with :func:`~gdnplan.trajopt.plan`."""
     r: Plan = plan(problem, collision=collision, weights=weights)
-    return Stage(name, problem.scene, r.q, r.success, r.min_distance, r.solve_time, True, r.reason)
+    scene = problem.scene
+    return Stage(name, scene, r.q, r.success, r.min_distance, r.solve_time, True, r.reason, r.times)
+
+
+def _scripted_times(scene: Scene, path: np.ndarray) -> np.ndarray:
+    """(T,) times of a scripted path at the URDF velocity limits (s)."""
+    return time_path(path, urdf_velocity(scene.robot)).times
 
 
 def run_fetch(
@@ -164,11 +177,12 @@ def run_fetch(
         elif name == "grasp":
             t0 = time.perf_counter()
             d = float(signed_distance(held, info["q_grasp"])[0])
+            at_grasp = np.array([info["q_grasp"]] * 2)
             out.append(
                 Stage(
                     name,
                     held,
-                    np.array([info["q_grasp"]] * 2),
+                    at_grasp,
                     d >= -RESTING_CONTACT_TOL,
                     d,
                     time.perf_counter() - t0,
@@ -176,6 +190,7 @@ def run_fetch(
                     f"gripper closed on a {held.robot.info['stick_length']:.3f} m × "
                     f"{held.robot.info['stick_width']:.3f} m stick; it rests on its shelf "
                     f"(d = {d:.4f} m)",
+                    _scripted_times(held, at_grasp),
                 )
             )
         elif name == "lift":
@@ -193,6 +208,7 @@ def run_fetch(
                     False,
                     f"scripted vertical lift of {LIFT} m; certified from "
                     f"{1000 * LIFT / (LIFT_POINTS - 1):.0f} mm above the shelf",
+                    _scripted_times(held, path),
                 )
             )
         elif name == "bring_out":

@@ -20,6 +20,7 @@ MAX_STARTS = 50
 MAX_ITER = 10_000  # Ipopt iterations per attempt
 MAX_ADAM_ITERATIONS = 100_000
 MAX_RRT_TIME = 600.0  # s, one RRT-Connect run
+MAX_TIMED_SAMPLES = 1_000_000  # TimedTrajectory.sample: time samples of one call
 
 # Ipopt options a [solver] ipopt table may set: name -> float, int, or the allowed strings
 IPOPT_OPTIONS: dict[str, type | tuple[str, ...]] = {

@@ -62,6 +62,7 @@ from .models import CoalModel, DistanceModel, load_model
 from .robot import Robot, first_outside
 from .rrt import seed_path
 from .scene import Scene, no_unknown_keys, scene_from_config
+from .timing import TimedTrajectory, limit_vector, plan_timing
 
 # problem-file keys (docs/problem_file.md documents each; tests/test_problem_file_docs.py checks);
 # [robot], [scene], [[obstacles]]: scene.ROBOT_KEYS etc.; [solver]: SOLVER_KEYS
@@ -519,13 +520,18 @@ class Plan:
         sampled_min_distance: smallest coal distance over the configurations the certificate
             checked (m): an upper bound on the path's minimum (the true minimum lies in
             [min_distance, sampled_min_distance]).
-        solve_time: wall time of the whole call: seeds, solves, verification (s).
+        solve_time: wall time of the whole call: seeds, solves, verification (s); the time
+            parametrisation after them is not included.
         iterations: solver iterations summed over attempts.
         status: the solver's last return status (Ipopt's, or "adam: …").
         reason: why the plan failed (or which attempt succeeded).
         path_cost: Σ_t ‖q_{t+1} − q_t‖² (rad²).
         model_calls: batched distance-model calls made by the solver.
         attempts: solver runs made.
+        trajectory: the time parametrisation of the certified path
+            (:class:`~gdnplan.timing.TimedTrajectory`) under the robot's URDF velocity limits (or
+            ``plan(max_velocity=…)``) and ``plan(max_acceleration=…)``; None for a failed plan
+            and for a robot without velocity limits (``reason`` says which joint).
     """
 
     success: bool
@@ -539,6 +545,27 @@ class Plan:
     model_calls: int
     attempts: int
     sampled_min_distance: float
+    trajectory: TimedTrajectory | None = None
+
+    @property
+    def times(self) -> np.ndarray | None:
+        """(T,) time of each waypoint of q (s), 0 first; None without a trajectory."""
+        return None if self.trajectory is None else self.trajectory.times
+
+    @property
+    def duration(self) -> float | None:
+        """Duration of the trajectory (s); None without one."""
+        return None if self.trajectory is None else self.trajectory.duration
+
+    def sample(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Times (N,) 0, dt, …, duration (s) and configurations q (N, dof) rad on the
+        trajectory (:meth:`gdnplan.timing.TimedTrajectory.sample`)."""
+        if self.trajectory is None:
+            raise InputError(
+                "sample: this plan has no trajectory (it failed, or the robot has no velocity "
+                "limits: see its reason)"
+            )
+        return self.trajectory.sample(dt)
 
 
 def path_cost(q: np.ndarray) -> float:
@@ -583,11 +610,15 @@ def plan(
     weights: str | Path | None = None,
     seed: int = 0,
     options: TrajoptOptions | None = None,
+    max_velocity=None,
+    max_acceleration=None,
 ) -> Plan:
     """Plan a trajectory for ``problem``; see the module docstring for the formulation.
 
     ``options`` default to the problem's own solver settings (``problem.solver``), else to
-    :class:`TrajoptOptions`' defaults.
+    :class:`TrajoptOptions`' defaults. ``max_velocity`` (rad/s; default: the URDF's limits)
+    and ``max_acceleration`` (rad/s²; default None: velocity limits only), one number or one
+    per joint, time the certified path (:func:`gdnplan.timing.time_path`, ``Plan.times``).
 
     Raises GdnplanError on bad input; a failed solve returns ``Plan(success=False, reason=…)``.
     """
@@ -597,6 +628,11 @@ def plan(
         raise InputError(f"options: expected TrajoptOptions, got {type(opts).__name__}")
     opts = replace(opts)  # re-runs the checks (a frozen dataclass can still be forged)
     _check_sizes(problem, opts, solver)
+    dof = problem.scene.robot.dof
+    if max_velocity is not None:
+        max_velocity = limit_vector(max_velocity, dof, "max_velocity", "rad/s")
+    if max_acceleration is not None:
+        max_acceleration = limit_vector(max_acceleration, dof, "max_acceleration", "rad/s²")
     model = resolve_model(collision, problem.scene, weights)
     goal = problem.goal if problem.goal is not None else solve_ik(problem, seed)
     if solver == "ipopt":
@@ -605,7 +641,12 @@ def plan(
         run = _plan_adam(problem, model, goal, opts)
     else:
         raise InputError(f"solver: unknown {solver!r}; choose 'ipopt' or 'adam'")
-    return _finish(problem, run, t0)
+    result = _finish(problem, run, t0)
+    trajectory, note = plan_timing(
+        problem.scene, result.q, result.success, max_velocity, max_acceleration
+    )
+    reason = f"{result.reason}; {note}".strip("; ") if note else result.reason
+    return replace(result, trajectory=trajectory, reason=reason)
 
 
 def _check_sizes(problem: Problem, opts: TrajoptOptions, solver: str) -> None:

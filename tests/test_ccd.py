@@ -179,3 +179,9 @@ def test_coal_overestimates_by_at_most_its_slack(name):
     free = d > 0
     error = d[free] - exact_distance(scene, q[free])
     assert np.all(error <= COAL_SLACK * (1 + d[free]))
+
+
+def test_a_scene_without_obstacles_is_certified_at_once():
+    empty = gp.make_scene("a").with_obstacles([])
+    cert = certify_path(empty, np.array([[0.0, 0.0], [0.5, 0.5]]))
+    assert cert.ok and cert.lower_bound == np.inf and cert.n_checks == 11  # no bisection

@@ -1,0 +1,357 @@
+"""Time parametrisation of a certified joint path under velocity and acceleration limits.
+
+The planner certifies the piecewise-linear path through its waypoints q_0 … q_{T−1} (rad)
+(:func:`gdnplan.ccd.certify_path`). :func:`time_path` gives it times 0 = t_0 ≤ … ≤ t_{T−1} (s)
+in one of three ways, each of them along a path that is certified collision-free:
+
+``linear`` (velocity limits v only, the default): the exact waypoint polygon at constant speed,
+    segment k taking τ_k = max_j |Δq_{k,j}| / v_j. The fastest motion along the polygon under
+    |q̇_j| ≤ v_j; the velocity jumps at the waypoints (unbounded acceleration there).
+``smooth`` (acceleration limits a given, and a scene): the shape-preserving cubic (PCHIP) p(s)
+    through the waypoints, s the cumulative chord length (rad), time-parametrised by toppra
+    (time-optimal, reachability analysis) under |p'_j(s) ṡ| ≤ v_j and
+    |p''_j(s) ṡ² + p'_j(s) s̈| ≤ a_j, at rest at both ends. toppra enforces the limits at its grid
+    points (:data:`GRID_PER_SEGMENT` per segment, plus one just before every waypoint, where p''
+    jumps); the time axis is then stretched by c ≥ 1 so that the limits hold at
+    :data:`CHECKS_PER_CELL` points per grid cell with ``STRETCH_SLACK`` to spare (velocities
+    scale by 1/c, accelerations by 1/c²).
+    The curve leaves the polygon, so it gets its own certificate (:mod:`gdnplan.ccd_curve`).
+``stop`` (acceleration limits, no scene or the smooth curve not certified): the exact polygon,
+    at rest at every waypoint, each segment the time-optimal trapezoidal (or triangular) profile
+    of σ ∈ [0, 1] under σ̇ ≤ min_j v_j / |Δq_j| and |σ̈| ≤ min_j a_j / |Δq_j|. A polygon
+    with corners cannot be followed exactly at bounded acceleration without stopping at them.
+
+The curve certificate (:mod:`gdnplan.ccd_curve`) is the planner's (bound (1) of
+:mod:`gdnplan.ccd`) with each joint's straight travel |Δq_j| replaced by the cubic's exact total
+variation over the piece.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .ccd_curve import certify_curve
+from .errors import InputError
+from .limits import MAX_TIMED_SAMPLES, check_number, is_number
+from .robot import Robot
+from .scene import Scene
+
+GRID_PER_SEGMENT = 8  # toppra grid cells per waypoint segment (fewer above MAX_GRID)
+MAX_GRID = 4000  # toppra grid points at most
+CHECKS_PER_CELL = 8  # limit checks per toppra grid cell (the time stretch c)
+BEFORE_KNOT = (1e-6, 1e-3)  # grid points this share of a segment before each inner knot
+STRETCH_SLACK = 1e-3  # c is raised by this fraction (the limits hold between the checks too)
+KINDS = ("linear", "smooth", "stop")
+
+
+def limit_vector(value, dof: int, name: str, unit: str) -> np.ndarray:
+    """(dof,) limits from one number or dof numbers, each finite and > 0, else InputError."""
+    if is_number(value):
+        value = [value] * dof
+    items = list(value) if isinstance(value, (list, tuple, np.ndarray)) else None
+    if items is None or len(items) != dof or not all(is_number(x) for x in items):
+        raise InputError(f"{name}: expected a number or {dof} numbers ({unit}), got {value!r}")
+    out = np.asarray(items, float)
+    if not np.all(np.isfinite(out) & (out > 0)):
+        raise InputError(f"{name}: expected finite limits > 0 ({unit}), got {out.tolist()}")
+    return out
+
+
+def urdf_velocity(robot: Robot) -> np.ndarray:
+    """(dof,) velocity limits of the robot's URDF (rad/s); InputError naming the first joint
+    whose limit is missing (URDF velocity="0"; a continuous joint without <limit> gives inf)."""
+    v = np.asarray(robot.model.velocityLimit, float)
+    bad = np.flatnonzero(~(np.isfinite(v) & (v > 0)))
+    if len(bad):
+        j = int(bad[0])
+        raise InputError(
+            f"max_velocity: joint {robot.joint_names[j]!r} of robot {robot.name!r} has velocity "
+            f"limit {v[j]:g} in its URDF; set <limit velocity=...> (rad/s) there or pass "
+            "max_velocity"
+        )
+    return v
+
+
+@dataclass(frozen=True, eq=False)
+class TimedTrajectory:
+    """A path q(t), t ∈ [0, duration] (s), through the waypoints at ``times``; see the module.
+
+    Attributes:
+        kind: "linear", "smooth" or "stop" (the module docstring says which path each follows).
+        times: (T,) time of each waypoint (s), times[0] = 0, non-decreasing.
+        waypoints: (T, dof) the waypoints (rad).
+        max_velocity: (dof,) velocity limits (rad/s).
+        max_acceleration: (dof,) acceleration limits (rad/s²), None for ``linear``.
+        min_distance: ``smooth``: proven lower bound on the coal distance along the curve (m);
+            None: the path is the waypoint polygon, whose certificate the planner made.
+    """
+
+    kind: str
+    times: np.ndarray
+    waypoints: np.ndarray
+    max_velocity: np.ndarray
+    max_acceleration: np.ndarray | None
+    min_distance: float | None = None
+    _profile: object = field(default=None, repr=False)
+
+    @property
+    def duration(self) -> float:
+        """Total time (s)."""
+        return float(self.times[-1])
+
+    def evaluate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """q (N, dof) rad, q̇ rad/s, q̈ rad/s² at times t (N,) s, clipped to [0, duration].
+
+        ``linear``: q̇ is the velocity of the segment t lies in (0 at the end), q̈ = 0 (the
+        velocity jumps at waypoints). ``stop``/``smooth``: q̈ is the one-sided value at the
+        switching times of the profile.
+        """
+        t = np.atleast_1d(np.asarray(t, float))
+        if t.ndim != 1 or not np.all(np.isfinite(t)):
+            raise InputError("t: expected finite times (s) in a 1-D array")
+        return self._profile.state(np.clip(t, 0.0, self.duration))
+
+    def sample(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Times (N,) 0, dt, 2 dt, …, duration (s; the last step may be shorter) and q (N, dof).
+
+        ``dt`` must be finite and > 0, and give at most ``MAX_TIMED_SAMPLES`` samples.
+        """
+        check_number(dt, "dt", strict=True)
+        n = math.floor(self.duration / dt) + 2
+        if n > MAX_TIMED_SAMPLES:
+            raise InputError(
+                f"dt: {dt:g} s gives {n} samples of a {self.duration:.3f} s trajectory, the limit "
+                f"is {MAX_TIMED_SAMPLES}; use dt ≥ {self.duration / (MAX_TIMED_SAMPLES - 2):.3g}"
+            )
+        t = np.arange(n - 1) * float(dt)
+        t = np.append(t[t < self.duration - 1e-9 * dt], self.duration)
+        return t, self.evaluate(t)[0]
+
+
+def _segment_of(times: np.ndarray, t: np.ndarray) -> np.ndarray:
+    return np.clip(np.searchsorted(times, t, side="right") - 1, 0, max(len(times) - 2, 0))
+
+
+class _Linear:
+    def __init__(self, q: np.ndarray, v: np.ndarray):
+        self.q, self.step = q, np.diff(q, axis=0)
+        tau = np.max(np.abs(self.step) / v, axis=1) if len(q) > 1 else np.zeros(0)
+        self.times = np.concatenate([[0.0], np.cumsum(tau)])
+        self.tau = tau
+
+    def state(self, t):
+        if len(self.q) == 1:
+            z = np.zeros((len(t), self.q.shape[1]))
+            return self.q[[0] * len(t)], z, z
+        k = _segment_of(self.times, t)
+        tau = self.tau[k][:, None]
+        rate = np.divide(1.0, tau, out=np.zeros_like(tau), where=tau > 0)
+        frac = np.clip((t - self.times[k])[:, None] * rate, 0.0, 1.0)
+        qd = self.step[k] * rate * (t < self.times[-1])[:, None]
+        return self.q[k] + frac * self.step[k], qd, np.zeros_like(qd)
+
+
+class _Stops:
+    """Rest-to-rest trapezoidal profile σ(t) on every segment q_k + σ Δq_k."""
+
+    def __init__(self, q: np.ndarray, v: np.ndarray, a: np.ndarray):
+        self.q, self.step = q, np.diff(q, axis=0)
+        size = np.abs(self.step)
+        with np.errstate(divide="ignore"):
+            vs = np.min(v / size, axis=1, initial=np.inf) if len(size) else np.zeros(0)
+            acc = np.min(a / size, axis=1, initial=np.inf) if len(size) else np.zeros(0)
+        moving = np.isfinite(vs)
+        vs, acc = np.where(moving, vs, 1.0), np.where(moving, acc, 1.0)
+        triangle = vs**2 >= acc
+        self.peak = np.where(triangle, np.sqrt(acc), vs)
+        self.acc, self.ramp = acc, self.peak / acc
+        self.tau = np.where(moving, np.where(triangle, 2 * self.ramp, 1 / vs + vs / acc), 0.0)
+        self.times = np.concatenate([[0.0], np.cumsum(self.tau)])
+
+    def state(self, t):
+        if len(self.q) == 1:
+            z = np.zeros((len(t), self.q.shape[1]))
+            return self.q[[0] * len(t)], z, z
+        k = _segment_of(self.times, t)
+        x = np.clip(t - self.times[k], 0.0, self.tau[k])
+        acc, peak, ramp, tau = self.acc[k], self.peak[k], self.ramp[k], self.tau[k]
+        rest = tau - x
+        up, down = x < ramp, rest < ramp
+        sig = np.where(up, 0.5 * acc * x**2, 0.5 * acc * ramp**2 + peak * (x - ramp))
+        sig = np.where(down & ~up, 1.0 - 0.5 * acc * rest**2, sig)
+        sd = np.where(up, acc * x, np.where(down, acc * rest, peak))
+        sdd = np.where(up, acc, np.where(down, -acc, 0.0))
+        sig, sd, sdd = (np.where(tau > 0, y, 0.0)[:, None] for y in (sig, sd, sdd))
+        return self.q[k] + sig * self.step[k], sd * self.step[k], sdd * self.step[k]
+
+
+class _Smooth:
+    """PCHIP path p(s) with toppra's s(t): ṡ² linear in s on each grid cell, time stretch c."""
+
+    def __init__(self, curve, grid, sd, stretch: float = 1.0):
+        self.p, self.dp, self.ddp = curve, curve.derivative(), curve.derivative(2)
+        self.grid, self.sd, self.c = grid, sd, stretch
+        dg = np.diff(grid)
+        self.u = (sd[1:] ** 2 - sd[:-1] ** 2) / (2 * dg)
+        self.ts = np.concatenate([[0.0], np.cumsum(2 * dg / (sd[1:] + sd[:-1]))])
+
+    def at_grid(self, cell: np.ndarray, x: np.ndarray):
+        """(s, ṡ, s̈) at time x after the start of grid cell ``cell`` (toppra's time)."""
+        sd, u = self.sd[cell], self.u[cell]
+        s = np.minimum(self.grid[cell] + sd * x + 0.5 * u * x**2, self.grid[cell + 1])
+        return s, sd + u * x, u
+
+    def derivatives(self, s, sd, sdd):
+        dp = self.dp(s)
+        return self.p(s), dp * sd[:, None], self.ddp(s) * (sd**2)[:, None] + dp * sdd[:, None]
+
+    def state(self, t):
+        tt = t / self.c
+        cell = _segment_of(self.ts, tt)
+        q, qd, qdd = self.derivatives(*self.at_grid(cell, tt - self.ts[cell]))
+        return q, qd / self.c, qdd / self.c**2
+
+
+def _chord_knots(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cumulative chord length of the distinct waypoints (K,) and each waypoint's knot (T,)."""
+    keep = np.concatenate([[True], np.any(np.diff(q, axis=0) != 0, axis=1)])
+    index = np.cumsum(keep) - 1
+    distinct = q[keep]
+    knots = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(distinct, axis=0), axis=1))])
+    return knots, index
+
+
+def _toppra(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> _Smooth | None:
+    """toppra's time-optimal s(t) on ``curve``; None when toppra finds no parametrisation."""
+    import logging
+
+    try:
+        import toppra  # noqa: F401  (imported for use in _toppra_on_grid)
+    except ImportError as e:  # PyPI has toppra wheels for Linux x86-64 only
+        raise InputError(
+            f"max_acceleration: the smooth timing needs toppra ({e}); pip install toppra, "
+            "or time the plan without max_acceleration"
+        ) from e
+
+    logging.getLogger("toppra").setLevel(logging.ERROR)
+    segments = len(knots) - 1
+    m = max(2, min(GRID_PER_SEGMENT, MAX_GRID // (2 * segments)))
+    cells = np.linspace(0.0, 1.0, m + 1)[:-1]
+    cells = (knots[:-1, None] + cells[None] * np.diff(knots)[:, None]).ravel()
+    for offset in BEFORE_KNOT:  # the closest first; toppra may call it uncontrollable
+        before = knots[1:-1] - offset * np.diff(knots)[:-1]  # p'' jumps at every knot
+        grid = np.unique(np.concatenate([cells, before, knots[-1:]]))
+        prof = _toppra_on_grid(curve, knots, grid, v, a)
+        if prof is not None:
+            return prof
+    return None
+
+
+def _toppra_on_grid(curve, knots, grid, v, a) -> _Smooth | None:
+    """toppra on one grid (None when it finds no parametrisation); the time stretch c makes
+    the limits hold at CHECKS_PER_CELL points of every cell whatever the grid."""
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint as tc
+    from toppra.algorithm.algorithm import ParameterizationReturnCode
+
+    class Path(toppra.interpolator.AbstractGeometricPath):
+        dof = curve.c.shape[2]
+        path_interval = np.array([knots[0], knots[-1]])
+
+        def __call__(self, s, order=0):
+            return curve(s, order)
+
+    constraints = [
+        tc.JointVelocityConstraint(np.column_stack([-v, v])),
+        tc.JointAccelerationConstraint(
+            np.column_stack([-a, a]), discretization_scheme=tc.DiscretizationType.Interpolation
+        ),
+    ]
+    algo = toppra.algorithm.TOPPRA(constraints, Path(), gridpoints=grid)
+    algo.compute_parameterization(0.0, 0.0)
+    data = algo.problem_data
+    sd = data.sd_vec
+    if data.return_code != ParameterizationReturnCode.Ok or sd is None:
+        return None
+    sd = np.maximum(np.asarray(sd, float), 0.0)
+    if not np.all(np.isfinite(sd)) or np.any(sd[1:] + sd[:-1] <= 0):
+        return None
+    prof = _Smooth(curve, grid, sd)
+    # the cell's end itself belongs to the next cell's cubic piece: check just before it, where
+    # p'' takes its left limit (it jumps at the knots)
+    x = np.append(np.linspace(0.0, 1.0, CHECKS_PER_CELL + 1)[:-1], 1.0 - 1e-9)
+    cell = np.repeat(np.arange(len(grid) - 1), len(x))
+    after = np.tile(x, len(grid) - 1) * np.diff(prof.ts)[cell]
+    _, qd, qdd = prof.derivatives(*prof.at_grid(cell, after))
+    worst = max(float(np.max(np.abs(qd) / v)), math.sqrt(float(np.max(np.abs(qdd) / a))))
+    prof.c = max(1.0, worst * (1.0 + STRETCH_SLACK))
+    return prof
+
+
+def time_path(
+    q: np.ndarray,
+    max_velocity,
+    max_acceleration=None,
+    scene: Scene | None = None,
+) -> TimedTrajectory:
+    """Time-parametrise the certified waypoint path q (T, dof) rad; see the module docstring.
+
+    Args:
+        q: (T, dof) finite waypoints (rad), T ≥ 1.
+        max_velocity: velocity limit (rad/s), one number or dof numbers, each > 0.
+        max_acceleration: acceleration limit (rad/s²) likewise; None: ``linear``.
+        scene: with max_acceleration, try the ``smooth`` curve and certify it here; None (or a
+            curve whose certificate fails, or toppra finding no solution): ``stop``.
+    """
+    q = np.asarray(q, float)
+    if q.ndim != 2 or len(q) < 1 or not np.all(np.isfinite(q)):
+        raise InputError(f"q: expected finite (T, dof) waypoints (rad), got shape {q.shape}")
+    v = limit_vector(max_velocity, q.shape[1], "max_velocity", "rad/s")
+    if max_acceleration is None:
+        prof = _Linear(q, v)
+        return TimedTrajectory("linear", prof.times, q, v, None, None, prof)
+    a = limit_vector(max_acceleration, q.shape[1], "max_acceleration", "rad/s²")
+    knots, index = _chord_knots(q)
+    if scene is not None and len(knots) > 1:
+        from scipy.interpolate import PchipInterpolator  # imported here: 0.15 s
+
+        curve = PchipInterpolator(knots, q[np.unique(index, return_index=True)[1]], axis=0)
+        cert = certify_curve(scene, curve)
+        prof = _toppra(curve, knots, v, a) if cert.ok else None
+        if prof is not None:
+            at_knots = prof.c * prof.ts[np.searchsorted(prof.grid, knots)]
+            times = at_knots[index]
+            return TimedTrajectory("smooth", times, q, v, a, cert.lower_bound, prof)
+    prof = _Stops(q, v, a)
+    return TimedTrajectory("stop", prof.times, q, v, a, None, prof)
+
+
+def plan_timing(
+    scene: Scene, q: np.ndarray, success: bool, max_velocity=None, max_acceleration=None
+) -> tuple[TimedTrajectory | None, str]:
+    """The timing of a plan's path q (T, dof) and a note on why there is none ("" if there is).
+
+    None for a failed plan, and for a robot whose URDF lacks velocity limits when no
+    ``max_velocity`` is given (the note says which joint). ``max_acceleration`` selects the
+    ``smooth`` curve certified in ``scene`` (or ``stop``), see :func:`time_path`.
+    """
+    if not success:
+        return None, ""
+    try:
+        v = urdf_velocity(scene.robot) if max_velocity is None else max_velocity
+    except InputError as e:
+        return None, f"no timing: {e}"
+    return time_path(q, v, max_acceleration, scene if max_acceleration is not None else None), ""
+
+
+__all__ = [
+    "TimedTrajectory",
+    "limit_vector",
+    "plan_timing",
+    "time_path",
+    "urdf_velocity",
+]
