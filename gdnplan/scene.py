@@ -34,7 +34,7 @@ from .geometry import (
     limit_vertices,
     square,
 )
-from .robot import Robot, load_robot
+from .robot import Robot, load_builtins, load_robot
 
 MAX_OBSTACLES = 1000  # obstacle polygons of one scene
 MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
@@ -126,6 +126,7 @@ def register_scene(name: str) -> Callable:
 
 
 def scene_names() -> list[str]:
+    load_builtins()
     return sorted(_GENERATORS)
 
 
@@ -133,6 +134,8 @@ def make_scene(name: str, seed: int = 0, **options) -> Scene:
     """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
+    if name not in _GENERATORS:
+        load_builtins()
     if name not in _GENERATORS:
         raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
     return _GENERATORS[name](seed=seed, **options)

@@ -15,7 +15,6 @@ import numpy as np
 from ..distance import signed_distance, signed_distance_and_grad
 from ..errors import UnknownNameError
 from ..scene import Scene
-from .weights import card_path, read_card
 
 
 @runtime_checkable
@@ -50,20 +49,24 @@ class CoalModel:
         return signed_distance_and_grad(scene, q)
 
 
-def load_model(path: Path | str) -> DistanceModel:
+def load_model(path: Path | str, threads: int | None = None) -> DistanceModel:
     """Load a trained model: ``path`` (safetensors weights) and its JSON card beside it.
 
     The card's ``"model"`` field selects the class (``"graphdistnet"``, ``"clearancenet"``).
+    ``threads``: torch threads of its inference (None: the library default, 1;
+    :mod:`gdnplan.models.threads`); the model's ``threads`` attribute can be changed later.
     """
+    from .weights import card_path, read_card  # imports torch: only for learned models
+
     kind = read_card(path).get("model")
     if kind == "graphdistnet":
         from .graphdistnet import load_graphdistnet
 
-        return load_graphdistnet(path)
+        return load_graphdistnet(path, threads)
     if kind == "clearancenet":
         from .clearancenet import load as load_clearancenet
 
-        return load_clearancenet(path)
+        return load_clearancenet(path, threads)
     raise UnknownNameError(f"model: unknown model type {kind!r} in {card_path(path).name}")
 
 
