@@ -51,25 +51,43 @@ def _commands(
 ) -> None:
     """Collision-free trajectory planning with GraphDistNet."""
     _DEBUG["on"] = debug
-    show_progress(True)
 
 
 QUIET_HELP = "No progress lines on stderr (warnings and errors only)."
 
 
+class _StderrHandler(logging.StreamHandler):
+    """Log records as bare lines on the ``sys.stderr`` of the moment (tests replace it)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.setFormatter(logging.Formatter("%(message)s"))
+
+    @property
+    def stream(self):  # type: ignore[override]
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value) -> None:  # StreamHandler.__init__ assigns one; stderr is used
+        pass
+
+
 def show_progress(on: bool) -> None:
     """Print the library's progress (the ``gdnplan`` logger's INFO lines: planner and fetch
     stages) to stderr, or only its warnings when ``on`` is False. Progress never goes to
-    stdout, so ``--json`` output stays one JSON object. Replaces the handler of an earlier call
-    (tests call :func:`run` many times in one process)."""
+    stdout, so ``--json`` output stays one JSON object. Undone by :func:`hide_progress`."""
+    hide_progress()
     logger = logging.getLogger("gdnplan")
-    for old in [h for h in logger.handlers if getattr(h, "gdnplan_cli", False)]:
-        logger.removeHandler(old)
-    handler = logging.StreamHandler(sys.stderr)
-    handler.gdnplan_cli = True  # type: ignore[attr-defined]
-    handler.setFormatter(logging.Formatter("%(message)s"))
-    logger.addHandler(handler)
+    logger.addHandler(_StderrHandler())
     logger.setLevel(logging.INFO if on else logging.WARNING)
+
+
+def hide_progress() -> None:
+    """Detach the handler of :func:`show_progress` (``run`` calls it as a command ends)."""
+    logger = logging.getLogger("gdnplan")
+    for old in [h for h in logger.handlers if isinstance(h, _StderrHandler)]:
+        logger.removeHandler(old)
+    logger.setLevel(logging.NOTSET)
 
 
 THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
@@ -640,6 +658,8 @@ def run(args: list[str] | None = None) -> None:
         why = f"{type(e).__name__}: {one_line(str(e))}" if str(e) else type(e).__name__
         message = f"internal error ({why}); rerun with --debug for the traceback"
         code = _fail(e, message, EXIT_INTERNAL)
+    finally:
+        hide_progress()
     sys.exit(code if isinstance(code, int) else 0)
 
 

@@ -15,6 +15,7 @@ import numpy as np
 from ..distance import signed_distance, signed_distance_and_grad
 from ..errors import UnknownNameError
 from ..scene import Scene
+from .threads import inference_threads, set_inference_threads
 
 
 @runtime_checkable
@@ -70,4 +71,4 @@ def load_model(path: Path | str, threads: int | None = None) -> DistanceModel:
     raise UnknownNameError(f"model: unknown model type {kind!r} in {card_path(path).name}")
 
 
-__all__ = ["CoalModel", "DistanceModel", "load_model"]
+__all__ = ["CoalModel", "DistanceModel", "inference_threads", "load_model", "set_inference_threads"]
