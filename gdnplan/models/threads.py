@@ -11,10 +11,11 @@ their own, ``model.threads``:
   :func:`set_inference_threads` changed it (the CLI's ``--threads``).
 
 :func:`torch_threads` sets the count around each call and restores the caller's afterwards
-(``torch.set_num_threads`` costs well under a microsecond), so the caller's own torch work keeps
-its setting. Torch's thread count is process-wide: two Python threads running inference under
-different counts at the same time see each other's setting. Training (:mod:`gdnplan.train`)
-uses torch's global setting (``gdnplan train --threads``), not this one. DiffCo is numpy only.
+(a cheap call: ``benchmarks/threads.py`` compares switching per call with a fixed count), so
+the caller's own torch work keeps its setting. Torch's thread count is process-wide: two Python
+threads running inference under different counts at the same time see each other's setting.
+Training (:mod:`gdnplan.train`) uses torch's global setting (``gdnplan train --threads``), not
+this one. DiffCo is numpy only.
 """
 
 from __future__ import annotations
