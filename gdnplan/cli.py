@@ -38,6 +38,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     add_completion=False,
     rich_markup_mode=None,  # plain help: rendering it with rich costs ≈ 0.3 s per --help
+    context_settings={"max_content_width": 100},  # up to 100 columns in a wide terminal
 )
 
 
@@ -624,7 +625,7 @@ def field_command(
     grid: int = typer.Option(101, min=2, max=FIELD_GRID_MAX, help="Grid points per joint."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
 ) -> None:
-    """Distance fields over (q1, q2) from coal, DiffCo and GraphDistNet (the paper's Fig. 5)."""
+    """Distance fields over (q1, q2) from coal, DiffCo and GraphDistNet (paper Figure 5)."""
     from .evaluate import fig5
     from .viz import save_figure
 
