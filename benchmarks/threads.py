@@ -1,6 +1,6 @@
 """GraphDistNet distance + gradient under 1 torch thread vs torch's default, side by side.
 
-Usage: python benchmarks/threads.py [--env d] [--batch 64 1000] [--rounds 30]
+Usage: python benchmarks/threads.py [--env d] [--batch 64 1000] [--rounds 30] [--plans 2]
 
 On scene ``env`` (seed 0) with its shipped weights, ``distance_and_grad`` of ``batch`` random
 configurations (64: a planner-sized call) runs under three settings, interleaved call by call
@@ -11,8 +11,12 @@ configurations (64: a planner-sized call) runs under three settings, interleaved
 - ``1 thread, switched``: the caller at torch's default, the model at 1 (the library default):
   :func:`gdnplan.models.threads.torch_threads` sets 1 and restores the default on every call.
 
-Prints the median seconds per call, default / 1 thread, and the cost of switching, with the
-machine, date and load average (other jobs may share the CPU: compare ratios, not seconds).
+Then the whole planner, where the network calls alternate with Ipopt, CasADi and coal:
+``gdnplan.plan`` of ``problems/planar7_d.toml`` with GraphDistNet, the inference threads at
+torch's default and at 1, interleaved, ``--plans`` times each (0: skip).
+
+Prints the median seconds, default / 1 thread, and the cost of switching, with the machine,
+date and load average (other jobs may share the CPU: compare ratios, not seconds).
 """
 
 from __future__ import annotations
@@ -28,8 +32,10 @@ from pathlib import Path
 import torch
 
 import gdnplan as gp
+from gdnplan.models import set_inference_threads
 
-WEIGHTS = Path(__file__).resolve().parent.parent / "weights"
+ROOT = Path(__file__).resolve().parent.parent
+WEIGHTS = ROOT / "weights"
 
 
 def timed(fn) -> float:
@@ -67,11 +73,25 @@ def measure(env: str, batch: int, rounds: int, default: int) -> dict[str, float]
     return {name: statistics.median(t) for name, t in times.items()}
 
 
+def measure_plans(rounds: int, default: int) -> dict[int, float]:
+    """Median seconds of ``gdnplan.plan`` (planar7_d, GraphDistNet) per inference thread count."""
+    problem = gp.Problem.from_toml(ROOT / "problems" / "planar7_d.toml")
+    gp.plan(problem, collision="graphdistnet")  # warm-up: torch, weights
+    times: dict[int, list[float]] = {default: [], 1: []}
+    for _ in range(rounds):
+        for n, t in times.items():
+            set_inference_threads(n)
+            t.append(timed(lambda: gp.plan(problem, collision="graphdistnet")))
+    set_inference_threads(1)
+    return {n: statistics.median(t) for n, t in times.items()}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--env", default="d")
     parser.add_argument("--batch", type=int, nargs="+", default=[64, 1000])
     parser.add_argument("--rounds", type=int, default=30)
+    parser.add_argument("--plans", type=int, default=2, help="plans per setting (0: none)")
     args = parser.parse_args()
     default = torch.get_num_threads()
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
@@ -91,6 +111,12 @@ def main() -> None:
             f"| {batch} | {t['default']:.4f} | {one:.4f} | {t['1 thread, switched']:.4f} "
             f"| {t['default'] / one:.2f}× | {t['1 thread, switched'] / one:.2f}× |",
             flush=True,
+        )
+    if args.plans:
+        t = measure_plans(args.plans, default)
+        print(
+            f"| plan planar7_d | {t[default]:.2f} | {t[1]:.2f} | (the library default) "
+            f"| {t[default] / t[1]:.2f}× | |"
         )
     print(f"load average at end: {os.getloadavg()}")
 
