@@ -10,11 +10,13 @@ prints the traceback of errors 2 and 3 as well.
 from __future__ import annotations
 
 import json
+import logging
+import math
 import sys
 import traceback
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
 import typer
 
 try:  # typer ≥ 0.25 vendors click
@@ -24,13 +26,19 @@ except ImportError:  # pragma: no cover - older typer depends on click
 
 from .errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
 from .files import FIGURE_SUFFIXES, check_output_dir, check_output_path, write_text
-from .scene import Scene, make_scene, scene_from_config, scene_names
+
+if TYPE_CHECKING:  # the commands import numpy and the library when they run: a fast --help
+    import numpy as np
+
+    from .scene import Scene
 
 app = typer.Typer(
     help="Collision-free trajectory planning with GraphDistNet.",
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
+    rich_markup_mode=None,  # plain help: rendering it with rich costs ≈ 0.3 s per --help
+    context_settings={"max_content_width": 100},  # up to 100 columns in a wide terminal
 )
 
 
@@ -63,21 +71,65 @@ WEIGHTS_HELP = (
 )
 PROBLEM_HELP = "A problem TOML file or a shipped problem's name (fetch_reach, planar7_d, …)."
 
+QUIET_HELP = "No progress lines on stderr (warnings and errors only)."
+
+
+class _StderrHandler(logging.StreamHandler):
+    """Log records as bare lines on the ``sys.stderr`` of the moment (tests replace it)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.setFormatter(logging.Formatter("%(message)s"))
+
+    @property
+    def stream(self):  # type: ignore[override]
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value) -> None:  # StreamHandler.__init__ assigns one; stderr is used
+        pass
+
+
+def show_progress(on: bool) -> None:
+    """Print the library's progress (the ``gdnplan`` logger's INFO lines: planner and fetch
+    stages) to stderr, or only its warnings when ``on`` is False. Progress never goes to
+    stdout, so ``--json`` output stays one JSON object. Undone by :func:`hide_progress`."""
+    hide_progress()
+    logger = logging.getLogger("gdnplan")
+    logger.addHandler(_StderrHandler())
+    logger.setLevel(logging.INFO if on else logging.WARNING)
+
+
+def hide_progress() -> None:
+    """Detach the handler of :func:`show_progress` (``run`` calls it as a command ends)."""
+    logger = logging.getLogger("gdnplan")
+    for old in [h for h in logger.handlers if isinstance(h, _StderrHandler)]:
+        logger.removeHandler(old)
+    logger.setLevel(logging.NOTSET)
+
 
 THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
 
 
-def set_threads(threads: int) -> None:
-    """Set torch's intra-op threads; raises InputError unless threads ≥ 1."""
+def set_threads(threads: int, torch_global: bool = False) -> None:
+    """The learned models' inference threads (:mod:`gdnplan.models.threads`) and, with
+    ``torch_global`` (training, table runs), torch's own intra-op threads; InputError unless
+    threads ≥ 1. Without ``torch_global`` torch is not imported (coal-only commands)."""
     if threads < 1:
         raise InputError(f"--threads: expected ≥ 1, got {threads}")
-    import torch
+    from .models.threads import set_inference_threads
 
-    torch.set_num_threads(threads)
+    set_inference_threads(threads)
+    if torch_global:
+        import torch
+
+        torch.set_num_threads(threads)
 
 
 def parse_vector(text: str, name: str) -> np.ndarray:
     """'0.1, -0.2, 0.3' -> array; raises InputError naming ``name``."""
+    import numpy as np
+
     try:
         return np.array([float(v) for v in text.replace(",", " ").split()])
     except ValueError as e:
@@ -95,6 +147,7 @@ def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
     """A scene from a problem file or shipped problem name (with its start q), or from a
     scene generator name."""
     from .assets import problem_names
+    from .scene import make_scene, scene_names
 
     if (
         target.endswith(".toml")
@@ -113,6 +166,7 @@ def problem_scene_and_start(path: str | Path) -> tuple[Scene, np.ndarray | None]
     ``[goal]``, ``[start]`` optional) the checks of its tables. ProblemFileError names the file.
     """
     from .assets import problem_file
+    from .scene import scene_from_config
     from .trajopt import TOP_KEYS, Problem, _no_unknown, _vector
 
     cfg = read_toml(path)
@@ -191,6 +245,7 @@ def plan_command(
     max_acceleration: float = typer.Option(
         None, help="Joint acceleration limit (rad/s²) of the timing; default: velocity only."
     ),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
 ) -> None:
     """Plan a collision-free trajectory; success is certified by a dense coal check.
 
@@ -198,6 +253,7 @@ def plan_command(
     """
     from .trajopt import Problem, plan
 
+    show_progress(not quiet)
     if animate is not None:
         check_output_path(animate, (".gif",), "--animate")
     set_threads(threads)
@@ -242,14 +298,14 @@ def plan_command(
 
 def clearance_text(lower_bound: float) -> str:
     """'certified clearance ≥ +0.0123 m', or 'clearance not proven' for a −inf bound."""
-    if not np.isfinite(lower_bound):
+    if not math.isfinite(lower_bound):
         return "clearance not proven"
     return f"certified clearance ≥ {lower_bound:+.4f} m"
 
 
 def json_number(x: float) -> float | None:
     """x as a JSON number; None (null) when not finite (JSON has no infinities)."""
-    return float(x) if np.isfinite(x) else None
+    return float(x) if math.isfinite(x) else None
 
 
 def plan_summary(result, joint_names: list[str]) -> dict:
@@ -259,6 +315,8 @@ def plan_summary(result, joint_names: list[str]) -> dict:
     ``timing`` its kind (:mod:`gdnplan.timing`); both null when the plan has no trajectory.
     """
     traj = result.trajectory
+    import numpy as np
+
     return {
         "success": bool(result.success),
         "joint_names": list(joint_names),
@@ -276,7 +334,9 @@ def plan_summary(result, joint_names: list[str]) -> dict:
     }
 
 
-reproduce_app = typer.Typer(help="Reproduce the paper's tables.", no_args_is_help=True)
+reproduce_app = typer.Typer(
+    help="Reproduce the paper's tables.", no_args_is_help=True, rich_markup_mode=None
+)
 app.add_typer(reproduce_app, name="reproduce")
 
 EVAL_MODELS = ("coal", "diffco", "clearancenet", "graphdistnet")
@@ -399,7 +459,7 @@ def table2_command(
         raise InputError(f"--n: expected ≥ 1, got {n}")
     if first >= n:
         raise InputError(f"--first: expected a problem index below --n {n}, got {first}")
-    set_threads(threads)
+    set_threads(threads, torch_global=True)
     records, skipped = [], []
     for setting in chosen["settings"]:
         problems = table2.reaching_problems(setting, n, seed)[first:]
@@ -430,6 +490,7 @@ def fetch_command(
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     threads: int = typer.Option(1, help=THREADS_HELP),
     view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
 ) -> None:
     """The UR5e fetch: approach, reach in, grasp, lift, bring the stick out, retreat.
 
@@ -437,6 +498,7 @@ def fetch_command(
     """
     from .fetch import run_fetch
 
+    show_progress(not quiet)
     if animate is not None:
         check_output_path(animate, (".gif",), "--animate")
     set_threads(threads)
@@ -571,7 +633,7 @@ def train_command(
         if isinstance(e, InputError):
             raise InputError(f"--set: {e}") from e
         raise InputError(f"--set: a value of the wrong type in {set_} ({e})") from e
-    set_threads(threads)
+    set_threads(threads, torch_global=True)
     card = train(
         env,
         config,
@@ -612,15 +674,17 @@ def field_command(
     env: str = typer.Option("a", help="A 2-DoF environment (a or b)."),
     out: Path = typer.Option(Path("field.png"), help="Output PNG."),
     grid: int = typer.Option(101, min=2, max=FIELD_GRID_MAX, help="Grid points per joint."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
 ) -> None:
-    """The paper's Fig. 5: distance fields over (q1, q2) from coal, DiffCo and GraphDistNet."""
+    """Distance fields over (q1, q2) from coal, DiffCo and GraphDistNet (paper Figure 5)."""
     from .evaluate import fig5
     from .viz import save_figure
 
+    show_progress(not quiet)
     if env not in ("a", "b"):
         raise InputError(f"--env: expected a 2-DoF environment, a or b, got {env!r}")
     check_output_path(out, FIGURE_SUFFIXES, "--out")
-    save_figure(fig5(env, grid), out)
+    save_figure(fig5(env, grid, progress=not quiet), out)
     typer.echo(f"wrote {out}")
 
 
@@ -646,6 +710,8 @@ def run(args: list[str] | None = None) -> None:
         why = f"{type(e).__name__}: {one_line(str(e))}" if str(e) else type(e).__name__
         message = f"internal error ({why}); rerun with --debug for the traceback"
         code = _fail(e, message, EXIT_INTERNAL)
+    finally:
+        hide_progress()
     sys.exit(code if isinstance(code, int) else 0)
 
 

@@ -19,6 +19,7 @@ Definitions (coal is the ground truth f):
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -33,6 +34,8 @@ from .data import DATA_DIR, SPLITS, Dataset, load, make_shard, split_dir
 from .distance import signed_distance, signed_distance_and_grad
 from .errors import InputError
 from .models import DistanceModel
+
+log = logging.getLogger(__name__)
 
 DEFAULT_MARGIN = 0.0  # m: collision ⇔ f ≤ margin
 
@@ -604,22 +607,33 @@ def detour_path(
     return q
 
 
-def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000):
+def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000, progress: bool = False):
     """The paper's Fig. 5 for a 2-DoF environment: coal, DiffCo (score) and GraphDistNet fields.
 
-    Returns the matplotlib Figure; GraphDistNet is left out when its weights are missing.
+    Returns the matplotlib Figure; GraphDistNet is left out when its weights are missing. With
+    ``progress`` a tqdm bar on stderr counts the grid configurations evaluated.
     """
+    from tqdm import tqdm
+
     from .models import CoalModel
     from .models.diffco import DiffCo
     from .scene import make_scene
     from .viz import distance_field, field_figure
 
     scene = make_scene(env, seed=0)
-    fields = {"coal f (m)": distance_field(CoalModel(), scene, grid)}
-    fields["DiffCo score −s"] = distance_field(DiffCo.train(scene, n=diffco_train), scene, grid)
+    models = {"coal f (m)": CoalModel()}
+    t0 = time.perf_counter()
+    models["DiffCo score −s"] = DiffCo.train(scene, n=diffco_train)
+    log.info("field: DiffCo trained on %d samples, %.2f s", diffco_train, time.perf_counter() - t0)
     gdn = load_graphdistnet(env)
     if gdn is not None:
-        fields["GraphDistNet d̂ (m)"] = distance_field(gdn, scene, grid)
+        models["GraphDistNet d̂ (m)"] = gdn
+    total = len(models) * grid * grid
+    with tqdm(total=total, desc=f"field {env}", unit="q", disable=not progress) as bar:
+        fields = {
+            name: distance_field(model, scene, grid, progress=bar.update)
+            for name, model in models.items()
+        }
     path = detour_path(scene, np.array([1.3, 1.5]), np.array([1.3, -2.6]))
     return field_figure(scene, fields, path)
 

@@ -24,6 +24,7 @@ contact the grasp makes by design.
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +39,8 @@ from .scene import Scene, make_scene
 from .timing import time_path, urdf_velocity
 from .trajopt import Plan, Problem, TrajoptOptions, plan
 from .ur5e import LIFT, solve_ik
+
+log = logging.getLogger(__name__)  # one INFO line per finished stage
 
 STAGES = ("approach", "reach_in", "grasp", "lift", "bring_out", "retreat")
 LIFT_POINTS = 11  # IK points on the lift line, 2 mm apart
@@ -161,7 +164,8 @@ def run_fetch(
     """Run the fetch sequence (or the listed ``stages`` of it, in order) on fetch ``seed``.
 
     Every stage is run even when an earlier one failed (each starts from its own configuration
-    of ``scene.info``), so a failure is reported per stage.
+    of ``scene.info``), so a failure is reported per stage; each finished stage is logged
+    (``gdnplan.fetch`` logger, INFO).
     """
     scenes = fetch_scenes(seed)
     open_, held = scenes["open"], scenes["holding"]
@@ -221,6 +225,10 @@ def run_fetch(
             out.append(_planned(name, problem, collision, weights))
         else:
             raise InputError(f"stages: unknown stage {name!r}; choose from {STAGES}")
+        done = out[-1]
+        how = "planned" if done.planned else "scripted"
+        verdict = "certified" if done.success else "FAILED"
+        log.info("fetch stage %s: %s, %s, %.2f s", name, how, verdict, done.solve_time)
     return out
 
 

@@ -364,7 +364,22 @@ def register_robot(name: str) -> Callable:
     return wrap
 
 
+BUILTIN_MODULES = ("gdnplan.ur5e",)  # modules that register more built-in robots and scenes
+
+
+def load_builtins() -> None:
+    """Import the modules that register built-in robots and scenes outside robot.py and
+    scene.py (:mod:`gdnplan.ur5e`: the ur5e and ur5 robots, the fetch scene). The registries
+    call it on a name they do not know and when listing names, so ``import gdnplan`` need not
+    import them (pinocchio models, meshes)."""
+    import importlib
+
+    for module in BUILTIN_MODULES:
+        importlib.import_module(module)
+
+
 def robot_names() -> list[str]:
+    load_builtins()
     return sorted(_REGISTRY)
 
 
@@ -388,6 +403,8 @@ def load_robot(name: str, **options) -> Robot:
     Options are passed to the factory (e.g. ``gripper="holding", stick_length=0.3`` for ur5e).
     Results without options are cached: the same name returns the same object.
     """
+    if name not in _REGISTRY:
+        load_builtins()
     if name not in _REGISTRY:
         raise UnknownNameError(f"robot: unknown name {name!r}; choose one of {robot_names()}")
     if options:

@@ -35,7 +35,7 @@ from .geometry import (
     limit_vertices,
     square,
 )
-from .robot import Robot, factory_options, load_robot, robot_names, robot_options
+from .robot import Robot, factory_options, load_builtins, load_robot, robot_names, robot_options
 
 MAX_OBSTACLES = 1000  # obstacle polygons of one scene
 MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
@@ -131,6 +131,7 @@ def register_scene(name: str) -> Callable:
 
 
 def scene_names() -> list[str]:
+    load_builtins()
     return sorted(_GENERATORS)
 
 
@@ -146,6 +147,8 @@ def make_scene(name: str, seed: int = 0, **options) -> Scene:
     """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
+    if name not in _GENERATORS:
+        load_builtins()
     if name not in _GENERATORS:
         raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
     return _GENERATORS[name](seed=seed, **options)

@@ -28,6 +28,7 @@ never on the solver's word alone.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 import tomllib
@@ -63,6 +64,8 @@ from .robot import Robot, first_outside
 from .rrt import seed_path
 from .scene import Scene, no_unknown_keys, scene_from_config
 from .timing import TimedTrajectory, limit_vector, plan_timing
+
+log = logging.getLogger(__name__)  # stage lines at INFO (the CLI shows them on stderr)
 
 # problem-file keys (docs/problem_file.md documents each; tests/test_problem_file_docs.py checks);
 # [robot], [scene], [[obstacles]]: scene.ROBOT_KEYS etc.; [solver]: SOLVER_KEYS
@@ -591,7 +594,11 @@ def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | P
         return CoalModel()
     if collision != "graphdistnet":
         raise InputError(f"collision: unknown {collision!r}; choose 'coal' or 'graphdistnet'")
-    return checked(load_model(default_weights(scene) if weights is None else weights), scene)
+    t0 = time.perf_counter()
+    name = default_weights(scene) if weights is None else weights
+    model = checked(load_model(name), scene)
+    log.info("model: %s loaded, %.2f s", name, time.perf_counter() - t0)
+    return model
 
 
 def checked(model: DistanceModel, scene: Scene) -> DistanceModel:
@@ -686,6 +693,8 @@ def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
         )
     elif not reached:
         reason = f"{reason}; goal not reached"
+    verdict = f"ok, clearance ≥ {cert.lower_bound:+.4f} m" if cert.ok else "not proven"
+    log.info("certify: coal certificate %s%s", verdict, "" if reached else "; goal not reached")
     return Plan(
         success=bool(cert.ok and reached),
         q=run.q,
@@ -732,6 +741,7 @@ def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
             yield "straight line" + (f" (perturbed {attempt})" if attempt else ""), guess
             continue
         label = f"RRT-Connect seed {seed + attempt}"
+        t0 = time.perf_counter()
         for demand in dict.fromkeys((clearance, problem.margin)):  # narrow passage: margin only
             guess, _ = seed_path(
                 problem.scene,
@@ -745,6 +755,8 @@ def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
             )
             if guess is not None:
                 break
+        found = "path found" if guess is not None else "no path"
+        log.info("seed: %s: %s, %.2f s", label, found, time.perf_counter() - t0)
         yield label + (" (clearance = margin)" if demand < clearance else ""), guess
 
 
@@ -769,6 +781,7 @@ def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, 
     line = straight_line(problem.start, goal, problem.waypoints)
     if opts.initial == "auto" and _line_free(problem, line):
         status = "straight line certified free (optimal path cost, no solve needed)"
+        log.info("seed: %s", status)
         return _Run(q=line, status=status, reason=status)
     run = _Run(q=line)
     for attempt, (label, guess) in enumerate(_seeds(problem, goal, opts, seed)):
@@ -809,7 +822,8 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
     margin = problem.margin + (opts.learned_margin if learned else 0.0)
     raised = np.zeros(len(splits))  # margin raise of each segment (m)
     q, duals = guess, None
-    for _ in range(1 + (opts.refine_rounds if opts.ccd else 0)):
+    for round_ in range(1 + (opts.refine_rounds if opts.ccd else 0)):
+        t0 = time.perf_counter()
         nlp = _Transcription(
             problem,
             model,
@@ -823,6 +837,8 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         run.iterations += stats.get("iter_count", 0)
         run.model_calls += nlp.callback.model_calls
         status = stats["return_status"]
+        took, its = time.perf_counter() - t0, stats.get("iter_count", 0)
+        log.info("solve: Ipopt round %d: %s, %d iterations, %.2f s", round_ + 1, status, its, took)
         if status in SOLVER_ERRORS or status.startswith("exception"):
             run.verified = None  # q is not a solver iterate: never accept it
             return q, stats, False
@@ -831,6 +847,7 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         if cert.ok:
             return q, stats, True
         bad = list(cert.bad_segments)
+        log.info("certify: %d segment(s) not proven clear (more check points there)", len(bad))
         refined = splits.copy()
         refined[bad] *= 2
         duals = nlp.duals_on(refined) if opts.warm_start else None
@@ -1104,6 +1121,7 @@ def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -
         v = b2 * v + (1 - b2) * grad**2
         step = opts.adam_lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
         q = np.clip(q - step, problem.lower, problem.upper)
+    log.info("solve: %s, %d iterations", status, it)
     return _Run(q=q, iterations=it, status=status, reason=status, model_calls=calls, attempts=1)
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -125,18 +127,30 @@ def animate_paths(
 
 # -------------------------------------------------------------------- Table I figures
 def distance_field(
-    model, scene: Scene, n: int = 101, lim: float = np.pi
+    model,
+    scene: Scene,
+    n: int = 101,
+    lim: float = np.pi,
+    progress: Callable[[int], object] | None = None,
+    chunk: int = 8192,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A 2-DoF model's value over the grid (q1, q2) ∈ [−lim, lim]²: (q1 (n,), q2 (n,), D (n, n)).
 
-    ``D[i, j]`` is the value at (q1[j], q2[i]) (m for distances, a score for DiffCo).
+    ``D[i, j]`` is the value at (q1[j], q2[i]) (m for distances, a score for DiffCo). The n²
+    configurations are evaluated ``chunk`` at a time, ``progress(k)`` called after each chunk
+    of k (e.g. a tqdm bar's ``update``).
     """
     if scene.robot.dof != 2:
         raise InputError(f"scene: the field needs a 2-DoF robot, got {scene.robot.dof} joints")
     axis = np.linspace(-lim, lim, n)
     g1, g2 = np.meshgrid(axis, axis)
-    values = model.distance(scene, np.stack([g1.ravel(), g2.ravel()], 1))
-    return axis, axis, values.reshape(n, n)
+    q = np.stack([g1.ravel(), g2.ravel()], 1)
+    parts = []
+    for start in range(0, len(q), chunk):
+        parts.append(model.distance(scene, q[start : start + chunk]))
+        if progress is not None:
+            progress(len(parts[-1]))
+    return axis, axis, np.concatenate(parts).reshape(n, n)
 
 
 def end_effector(robot, q: np.ndarray) -> np.ndarray:

@@ -259,7 +259,7 @@ def _cli(code: str, *args: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", script, *args], capture_output=True, text=True)
 
 
-BOOM = "def boom(*a, **k):\n    raise {}\ncli.make_scene = boom"
+BOOM = "def boom(*a, **k):\n    raise {}\nimport gdnplan.scene\ngdnplan.scene.make_scene = boom"
 
 
 def test_unexpected_exception_is_one_line_exit_3_and_debug_shows_the_traceback():

@@ -264,7 +264,7 @@ def test_cli_json_carries_joint_names_and_times():
         app, ["plan", str(SQUARE), "--collision", "coal", "--json", "--max-acceleration", "4"]
     )
     assert result.exit_code == 0, result.output
-    out = json.loads(result.output)
+    out = json.loads(result.stdout)  # stage lines go to stderr
     assert out["joint_names"] == ["joint1", "joint2"] and out["timing"] == "smooth"
     t = np.array(out["t"])
     assert len(t) == len(out["q"]) and t[0] == 0 and np.all(np.diff(t) > 0)

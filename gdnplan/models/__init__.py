@@ -16,7 +16,7 @@ from ..assets import weights_file
 from ..distance import signed_distance, signed_distance_and_grad
 from ..errors import UnknownNameError
 from ..scene import Scene
-from .weights import card_path, read_card
+from .threads import inference_threads, set_inference_threads
 
 
 @runtime_checkable
@@ -51,25 +51,29 @@ class CoalModel:
         return signed_distance_and_grad(scene, q)
 
 
-def load_model(weights: Path | str) -> DistanceModel:
+def load_model(weights: Path | str, threads: int | None = None) -> DistanceModel:
     """Load a trained model: shipped weights by name or a ``.safetensors`` file with its card.
 
     ``weights``: a shipped name (``"d"``, ``"ur5e"``, ``"clearancenet_b"``; see
     :func:`gdnplan.assets.weights_names`) or a path to a ``.safetensors`` file whose JSON card
     sits beside it. The card's ``"model"`` field selects the class (``"graphdistnet"``,
     ``"clearancenet"``). The model refuses scenes of a robot it was not trained for.
+    ``threads``: torch threads of its inference (None: the library default, 1;
+    :mod:`gdnplan.models.threads`); the model's ``threads`` attribute can be changed later.
     """
+    from .weights import card_path, read_card  # imports torch: only for learned models
+
     path = weights_file(weights)
     kind = read_card(path).get("model")
     if kind == "graphdistnet":
         from .graphdistnet import load_graphdistnet
 
-        return load_graphdistnet(path)
+        return load_graphdistnet(path, threads)
     if kind == "clearancenet":
         from .clearancenet import load as load_clearancenet
 
-        return load_clearancenet(path)
+        return load_clearancenet(path, threads)
     raise UnknownNameError(f"model: unknown model type {kind!r} in {card_path(path).name}")
 
 
-__all__ = ["CoalModel", "DistanceModel", "load_model"]
+__all__ = ["CoalModel", "DistanceModel", "inference_threads", "load_model", "set_inference_threads"]

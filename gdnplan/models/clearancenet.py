@@ -38,6 +38,7 @@ from ..data import Dataset, pad_polygons
 from ..errors import InputError
 from ..scene import Scene, make_scene
 from .checks import build_net, card_config, check_count, check_fits, check_layout
+from .threads import check_threads, torch_threads
 from .weights import card_path, read_weights, write_weights
 
 POSE_ENVS = ("a", "b", "c", "d")
@@ -160,18 +161,31 @@ class ClearanceNet(nn.Module):
 
 
 class ClearanceNetModel:
-    """ClearanceNet as a :class:`~gdnplan.models.DistanceModel` (float64 at the API)."""
+    """ClearanceNet as a :class:`~gdnplan.models.DistanceModel` (float64 at the API), its
+    inference with ``threads`` torch threads (None: the library default, 1;
+    :mod:`gdnplan.models.threads`)."""
 
     is_distance = True
 
-    def __init__(self, net: ClearanceNet, card: dict | None = None, chunk: int = 8192):
+    def __init__(
+        self,
+        net: ClearanceNet,
+        card: dict | None = None,
+        chunk: int = 8192,
+        threads: int | None = None,
+    ):
         self.net = net.eval()
+        self.threads = check_threads(threads)
         self.card = card or {}
         self.chunk = chunk
         self.name = "ClearanceNet"
         self.dtype = next(net.parameters()).dtype  # float32 normally; float64 for checks
 
     def _run(self, q: np.ndarray, obst: np.ndarray, grad: bool):
+        with torch_threads(self.threads):
+            return self._run_chunks(q, obst, grad)
+
+    def _run_chunks(self, q: np.ndarray, obst: np.ndarray, grad: bool):
         ds, gs = [], []
         for s in range(0, len(q), self.chunk):
             qt = torch.as_tensor(q[s : s + self.chunk], dtype=self.dtype)
@@ -222,8 +236,10 @@ class ClearanceNetModel:
         return write_weights(path, self.net.state_dict(), card)
 
 
-def load(path: Path | str) -> ClearanceNetModel:
-    """A :class:`ClearanceNetModel` from ``path`` (.safetensors) and its JSON card."""
+def load(path: Path | str, threads: int | None = None) -> ClearanceNetModel:
+    """A :class:`ClearanceNetModel` from ``path`` (.safetensors) and its JSON card, running
+    inference with ``threads`` torch threads (None: the library default, 1)."""
+    threads = check_threads(threads)
     path = Path(path)
     tensors, card = read_weights(path)
     if card.get("model") != "clearancenet":
@@ -231,7 +247,7 @@ def load(path: Path | str) -> ClearanceNetModel:
     config = card_config(path, card, "ClearanceNet", ClearanceNetConfig.from_dict)
     check_count(len(config.hidden) or 1, len(tensors), "hidden", path)
     net = build_net(path, "ClearanceNet", lambda: ClearanceNet(config), tensors)
-    return ClearanceNetModel(net, card)
+    return ClearanceNetModel(net, card, threads=threads)
 
 
 def train(

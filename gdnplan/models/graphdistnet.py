@@ -78,6 +78,7 @@ from ..errors import InputError
 from ..graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
 from ..scene import Scene
 from .checks import build_net, card_config, check_count, check_fits
+from .threads import check_threads, torch_threads
 from .weights import read_weights
 
 PAD_DIST2 = 1e6  # squared distance (normalised units²) given to padded candidates
@@ -918,7 +919,8 @@ class GraphDistNetModel:
     (:meth:`~gdnplan.graph.RobotGraph.pullback`, float64). ``cross="soft_knn"`` networks run
     :meth:`GraphDistNet.lean`, others the reference :meth:`GraphDistNet.forward`. The graphs of
     a scene are built once per scene object (scenes are immutable) and cached. Results are
-    float64 numpy arrays.
+    float64 numpy arrays. Inference runs with ``threads`` torch threads (None: the library
+    default, 1; :mod:`gdnplan.models.threads`), the caller's count restored after each call.
     """
 
     name = "graphdistnet"
@@ -930,8 +932,10 @@ class GraphDistNetModel:
         chunk: int | None = None,
         dtype: torch.dtype = torch.float32,
         device: str | torch.device = "cpu",
+        threads: int | None = None,
     ):
         self.net = net.to(device, dtype).eval()
+        self.threads = check_threads(threads)
         self.config = net.config
         self.card = card or {}
         self.chunk = chunk
@@ -989,25 +993,27 @@ class GraphDistNetModel:
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
         """(B,) estimated signed distances (m) of q (B, dof) or (dof,)."""
         q = scene.robot.check_q(q)
-        graphs = self._graphs(scene)
-        gen = self._generator()
-        with torch.inference_mode():
-            out = [
-                self._estimate(graphs, self._tensor(graphs.robot.positions(q[part])), gen)
-                for part in self._chunks(len(q), graphs)
-            ]
-            return torch.cat(out).double().cpu().numpy()
+        with torch_threads(self.threads):
+            graphs = self._graphs(scene)  # outside inference mode: the cache serves autograd too
+            gen = self._generator()
+            with torch.inference_mode():
+                out = [
+                    self._estimate(graphs, self._tensor(graphs.robot.positions(q[part])), gen)
+                    for part in self._chunks(len(q), graphs)
+                ]
+                return torch.cat(out).double().cpu().numpy()
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad)."""
         q = scene.robot.check_q(q)
-        graphs = self._graphs(scene)
-        gen = self._generator()
-        ds, gs = [], []
-        for part in self._chunks(len(q), graphs):
-            taped = self._taped(graphs, q[part], gen)
-            ds.append(taped.d.detach())
-            gs.append(taped.grad(graphs.robot))
+        with torch_threads(self.threads):
+            graphs = self._graphs(scene)
+            gen = self._generator()
+            ds, gs = [], []
+            for part in self._chunks(len(q), graphs):
+                taped = self._taped(graphs, q[part], gen)
+                ds.append(taped.d.detach())
+                gs.append(taped.grad(graphs.robot))
         return torch.cat(ds).double().cpu().numpy(), np.concatenate(gs)
 
     def distance_deferred_grad(
@@ -1021,13 +1027,16 @@ class GraphDistNetModel:
         planner-sized batches: every chunk's graph is held until the gradient is taken.
         """
         q = scene.robot.check_q(q)
-        graphs = self._graphs(scene)
-        gen = self._generator()
-        tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
+        threads = self.threads
+        with torch_threads(threads):
+            graphs = self._graphs(scene)
+            gen = self._generator()
+            tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
 
         @functools.cache
         def gradient() -> np.ndarray:
-            return np.concatenate([t.grad(graphs.robot) for t in tapes])
+            with torch_threads(threads):
+                return np.concatenate([t.grad(graphs.robot) for t in tapes])
 
         return torch.cat([t.d.detach() for t in tapes]).double().cpu().numpy(), gradient
 
@@ -1071,8 +1080,10 @@ def _repeat(graph: GraphBatch, b: int) -> GraphBatch:
     return GraphBatch(*(t.expand(b, *t.shape[1:]) for t in parts))
 
 
-def load_graphdistnet(path: Path | str) -> GraphDistNetModel:
-    """A :class:`GraphDistNetModel` from ``path`` (safetensors) and the JSON card beside it."""
+def load_graphdistnet(path: Path | str, threads: int | None = None) -> GraphDistNetModel:
+    """A :class:`GraphDistNetModel` from ``path`` (safetensors) and the JSON card beside it,
+    running inference with ``threads`` torch threads (None: the library default, 1)."""
+    threads = check_threads(threads)
     path = Path(path)
     tensors, card = read_weights(path)
     config = card_config(path, card, "GraphDistNet", GraphDistNetConfig.from_dict)
@@ -1080,4 +1091,4 @@ def load_graphdistnet(path: Path | str) -> GraphDistNetModel:
         check_count(value, len(tensors), name, path)  # else a huge network before the check
     check_count(len(config.readout) or 1, len(tensors), "readout", path)
     net = build_net(path, "GraphDistNet", lambda: GraphDistNet(config), tensors)
-    return GraphDistNetModel(net, card)
+    return GraphDistNetModel(net, card, threads=threads)
