@@ -12,9 +12,9 @@ in one of three ways, each of them along a path that is certified collision-free
     (time-optimal, reachability analysis) under |p'_j(s) ṡ| ≤ v_j and
     |p''_j(s) ṡ² + p'_j(s) s̈| ≤ a_j, at rest at both ends. toppra enforces the limits at its grid
     points (:data:`GRID_PER_SEGMENT` per segment, plus one just before every waypoint, where p''
-    jumps); the time axis is then stretched by c ≥ 1 so that the limits hold at
-    :data:`CHECKS_PER_CELL` points per grid cell with ``STRETCH_SLACK`` to spare (velocities
-    scale by 1/c, accelerations by 1/c²).
+    jumps); the time axis is then stretched by c ≥ 1 so that proven bounds of |q̇_j| and |q̈_j|
+    over every grid cell (:func:`cell_bounds`) hold with ``STRETCH_SLACK`` to spare
+    (velocities scale by 1/c, accelerations by 1/c²).
     The curve leaves the polygon, so it gets its own certificate (:mod:`gdnplan.ccd_curve`).
 ``stop`` (acceleration limits, no scene or the smooth curve not certified): the exact polygon,
     at rest at every waypoint, each segment the time-optimal trapezoidal (or triangular) profile
@@ -41,9 +41,8 @@ from .scene import Scene
 
 GRID_PER_SEGMENT = 8  # toppra grid cells per waypoint segment (fewer above MAX_GRID)
 MAX_GRID = 4000  # toppra grid points at most
-CHECKS_PER_CELL = 8  # limit checks per toppra grid cell (the time stretch c)
-BEFORE_KNOT = (1e-6, 1e-3)  # grid points this share of a segment before each inner knot
-STRETCH_SLACK = 1e-3  # c is raised by this fraction (the limits hold between the checks too)
+BEFORE_KNOT = (1e-6, 1e-3, 0.0)  # grid points this share of a segment before inner knots (0: none)
+STRETCH_SLACK = 1e-9  # c is raised by this fraction (rounding of the cell bounds)
 KINDS = ("linear", "smooth", "stop")
 
 
@@ -243,7 +242,7 @@ def _toppra(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> _Smooth |
     cells = (knots[:-1, None] + cells[None] * np.diff(knots)[:, None]).ravel()
     for offset in BEFORE_KNOT:  # the closest first; toppra may call it uncontrollable
         before = knots[1:-1] - offset * np.diff(knots)[:-1]  # p'' jumps at every knot
-        grid = np.unique(np.concatenate([cells, before, knots[-1:]]))
+        grid = np.unique(np.concatenate([cells, before if offset else [], knots[-1:]]))
         prof = _toppra_on_grid(curve, knots, grid, v, a)
         if prof is not None:
             return prof
@@ -252,7 +251,7 @@ def _toppra(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> _Smooth |
 
 def _toppra_on_grid(curve, knots, grid, v, a) -> _Smooth | None:
     """toppra on one grid (None when it finds no parametrisation); the time stretch c makes
-    the limits hold at CHECKS_PER_CELL points of every cell whatever the grid."""
+    the limits hold on every cell whatever the grid (:func:`cell_bounds`)."""
     import toppra
     import toppra.algorithm
     import toppra.constraint as tc
@@ -281,15 +280,39 @@ def _toppra_on_grid(curve, knots, grid, v, a) -> _Smooth | None:
     if not np.all(np.isfinite(sd)) or np.any(sd[1:] + sd[:-1] <= 0):
         return None
     prof = _Smooth(curve, grid, sd)
-    # the cell's end itself belongs to the next cell's cubic piece: check just before it, where
-    # p'' takes its left limit (it jumps at the knots)
-    x = np.append(np.linspace(0.0, 1.0, CHECKS_PER_CELL + 1)[:-1], 1.0 - 1e-9)
-    cell = np.repeat(np.arange(len(grid) - 1), len(x))
-    after = np.tile(x, len(grid) - 1) * np.diff(prof.ts)[cell]
-    _, qd, qdd = prof.derivatives(*prof.at_grid(cell, after))
-    worst = max(float(np.max(np.abs(qd) / v)), math.sqrt(float(np.max(np.abs(qdd) / a))))
+    vel, acc = cell_bounds(curve, grid, sd, prof.u)
+    worst = max(float(np.max(vel / v)), math.sqrt(float(np.max(acc / a))))
     prof.c = max(1.0, worst * (1.0 + STRETCH_SLACK))
     return prof
+
+
+def cell_bounds(curve, grid: np.ndarray, sd: np.ndarray, u: np.ndarray):
+    """Upper bounds (cells, dof) of |q̇_j| and |q̈_j| over each grid cell [s_i, s_{i+1}].
+
+    In a cell ṡ² is linear in s (s̈ = u constant), so ṡ ≤ max(ṡ_i, ṡ_{i+1}) and
+
+        |q̇_j| = |p'_j| ṡ ≤ P1 · max ṡ,    |q̈_j| = |p''_j ṡ² + p'_j s̈| ≤ P2 · max ṡ² + P1 |u|,
+
+    with P1 = max |p'_j| (a quadratic on the cell: its ends and its vertex) and P2 = max |p''_j|
+    (linear on the cell: its ends, taken on the cell's own cubic piece — p'' jumps at knots).
+    Every cell lies inside one piece of the PCHIP curve (the grid holds every knot).
+    """
+    piece = np.clip(np.searchsorted(curve.x, grid[:-1], side="right") - 1, 0, len(curve.x) - 2)
+    c3, c2, c1 = curve.c[0, piece], curve.c[1, piece], curve.c[2, piece]  # (cells, dof)
+    h0 = (grid[:-1] - curve.x[piece])[:, None]
+    h1 = (grid[1:] - curve.x[piece])[:, None]
+
+    def d1(h):
+        return 3 * c3 * h**2 + 2 * c2 * h + c1
+
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = np.where(c3 != 0, -c2 / (3 * c3), h0)
+    inside = (vertex > h0) & (vertex < h1)
+    p1 = np.maximum(np.abs(d1(h0)), np.abs(d1(h1)))
+    p1 = np.where(inside, np.maximum(p1, np.abs(d1(np.where(inside, vertex, h0)))), p1)
+    p2 = np.maximum(np.abs(6 * c3 * h0 + 2 * c2), np.abs(6 * c3 * h1 + 2 * c2))
+    top = np.maximum(sd[:-1], sd[1:])[:, None]
+    return p1 * top, p2 * top**2 + p1 * np.abs(u)[:, None]
 
 
 def time_path(
