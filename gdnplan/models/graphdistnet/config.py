@@ -1,0 +1,129 @@
+"""GraphDistNet options: :class:`GraphDistNetConfig`, its presets and its dict form."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields, replace
+
+import numpy as np
+
+from ...errors import InputError
+
+
+@dataclass(frozen=True)
+class GraphDistNetConfig:
+    """Architecture, normalisation and loss options of GraphDistNet.
+
+    Attributes:
+        layers: K message-passing layers.
+        hidden: d_h, node feature size.
+        mlp: hidden widths of each h_k.
+        readout: hidden widths of the final MLP.
+        activation: ``"leaky_relu"`` (slope 0.2, the paper) or ``"silu"``.
+        cross: ``"argmax"`` (paper: random, then argmax partner) or ``"soft_knn"``.
+        cross_k: candidates k of ``soft_knn`` (k + 1 nearest nodes are looked at).
+        two_way: cross edges into both graphs (the paper). False: only robot nodes take a
+            cross partner (obstacle nodes have z̄_i = z_i), so the obstacle features depend on
+            the scene alone and inference computes them once per scene (package docstring).
+        tau: initial temperature τ of ``soft_knn`` (normalised units², learned per layer).
+        max_edge: densify graph edges longer than this (m), or None.
+        grad_weight: weight λ of the gradient loss λ · (1 − cos(∂d̂/∂q, ∂f/∂q)).
+        grad_norm_weight: weight ν of the slope loss ν · ((|∂d̂/∂q| − |∂f/∂q|) / scale)²
+            (trained with ``grad_weight`` > 0 only; the cosine leaves the slope free).
+        contact_weight: extra weight μ of samples near contact in the distance loss,
+            w = 1 + μ · exp(−|f| / contact_scale) (0 = paper: every sample alike).
+        contact_scale: distance (m) over which the contact weight decays.
+        node_distance: distance-aware nodes (beyond the paper): every layer's h_k also takes
+            s_i, node i's signed distance to the other graph's polygons (normalised units,
+            negative inside), as an absolute input (package docstring).
+        min_readout: a residual readout on the soft minimum of the node distances,
+            m = −τ_m log Σ_i exp(−s_i / τ_m) (τ_m learned, initially ``tau_min``):
+            d̂ = scale · (m + MLP(y_r ‖ y_o ‖ m)), the MLP's last layer starting at zero.
+            Needs ``node_distance``. Between apart polygons min_i s_i is the distance itself,
+            so the MLP learns a correction (penetration, edges crossing without a vertex inside).
+        tau_min: initial τ_m (normalised units).
+        probe_split: m's minimum also runs over the points splitting every ring edge into
+            this many pieces (1: the nodes only). Needs ``min_readout``.
+        correction_band: β (m) of a banded ``min_readout``, d̂ = scale · (g · MLP(…) +
+            (1 − g) · m), g = σ(8 (1 − scale · m / β)): the MLP's estimate in overlap and
+            near contact, m beyond ≈ 2β (None: the residual m + MLP everywhere). Needs
+            ``min_readout``.
+        scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
+        origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
+    """
+
+    layers: int = 4
+    hidden: int = 32
+    mlp: tuple[int, ...] = (32, 32, 32)
+    readout: tuple[int, ...] = (32, 32, 32)
+    activation: str = "leaky_relu"
+    cross: str = "soft_knn"
+    cross_k: int = 4
+    two_way: bool = True
+    tau: float = 0.02
+    max_edge: float | None = None
+    grad_weight: float = 0.0
+    grad_norm_weight: float = 0.0
+    contact_weight: float = 0.0
+    contact_scale: float = 0.02
+    node_distance: bool = False
+    min_readout: bool = False
+    tau_min: float = 1e-3
+    probe_split: int = 1
+    correction_band: float | None = None
+    scale: float = 1.0
+    origin: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if any(isinstance(v, float) and not math.isfinite(v) for v in np.ravel(value)):
+                raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
+        if self.activation not in ("leaky_relu", "silu"):
+            raise InputError(
+                f"activation: expected 'leaky_relu' or 'silu', got {self.activation!r}"
+            )
+        if self.cross not in ("argmax", "soft_knn"):
+            raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
+        if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
+            raise InputError("layers, hidden, cross_k and scale must be positive")
+        if self.grad_norm_weight < 0 or (self.grad_norm_weight > 0 and self.grad_weight <= 0):
+            raise InputError("grad_norm_weight must be ≥ 0, and needs grad_weight > 0")
+        if self.contact_weight < 0 or self.contact_scale <= 0:
+            raise InputError("contact_weight must be ≥ 0 and contact_scale positive")
+        if self.min_readout and not self.node_distance:
+            raise InputError("min_readout needs node_distance=True (it reads the node distances)")
+        if self.tau_min <= 0:
+            raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
+        if self.correction_band is not None and (self.correction_band <= 0 or not self.min_readout):
+            raise InputError("correction_band must be a positive length (m) and needs min_readout")
+        if self.probe_split < 1 or (self.probe_split > 1 and not self.min_readout):
+            raise InputError("probe_split must be ≥ 1, and > 1 needs min_readout")
+
+    @classmethod
+    def faithful(cls, **changes) -> GraphDistNetConfig:
+        """The paper's network: random/argmax partners, LeakyReLU, distance loss only."""
+        return cls(cross="argmax", **changes)
+
+    @classmethod
+    def smooth(cls, **changes) -> GraphDistNetConfig:
+        """The planner default: deterministic, continuous soft k-nearest partners."""
+        return cls(cross="soft_knn", **changes)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> GraphDistNetConfig:
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise InputError(f"config: unknown GraphDistNet options {sorted(unknown)}")
+        data = dict(data)
+        for key in ("mlp", "readout", "origin"):
+            if key in data:
+                data[key] = tuple(data[key])
+        return cls(**data)
+
+    def with_(self, **changes) -> GraphDistNetConfig:
+        return replace(self, **changes)

@@ -1,0 +1,26 @@
+"""GraphDistNet weights from a safetensors file and its JSON card (models/weights.py)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..checks import build_net, card_config, check_count
+from ..threads import check_threads
+from ..weights import read_weights
+from .config import GraphDistNetConfig
+from .model import GraphDistNetModel
+from .network import GraphDistNet
+
+
+def load_graphdistnet(path: Path | str, threads: int | None = None) -> GraphDistNetModel:
+    """A :class:`GraphDistNetModel` from ``path`` (safetensors) and the JSON card beside it,
+    running inference with ``threads`` torch threads (None: the library default, 1)."""
+    threads = check_threads(threads)
+    path = Path(path)
+    tensors, card = read_weights(path)
+    config = card_config(path, card, "GraphDistNet", GraphDistNetConfig.from_dict)
+    for name, value in (("layers", config.layers), ("mlp", len(config.mlp) or 1)):
+        check_count(value, len(tensors), name, path)  # else a huge network before the check
+    check_count(len(config.readout) or 1, len(tensors), "readout", path)
+    net = build_net(path, "GraphDistNet", lambda: GraphDistNet(config), tensors)
+    return GraphDistNetModel(net, card, threads=threads)

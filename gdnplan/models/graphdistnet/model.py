@@ -1,0 +1,196 @@
+"""GraphDistNet as a :class:`~gdnplan.models.DistanceModel`: scene cache, chunks, threads,
+and the gradient ∂d̂/∂q through the robot graph's pullback."""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import weakref
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ...graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
+from ...scene import Scene
+from ..checks import check_fits
+from ..threads import check_threads, torch_threads
+from .lean import SceneGraph
+from .network import GraphDistNet
+
+# graph nodes per inference pass: (d) two-way 80 configurations × 108 nodes, one-way 320 × 28
+# were the fastest chunks on the 2-core Xeon (benchmarks/RESULTS.md)
+CHUNK_NODES = 9000
+
+
+class GraphDistNetModel:
+    """A trained GraphDistNet as a :class:`~gdnplan.models.DistanceModel`.
+
+    q → node positions (:meth:`~gdnplan.graph.RobotGraph.kinematics`, float64) → d̂ in
+    ``dtype`` (float32 by default) in equal chunks of at most ``chunk`` samples (default: about
+    ``CHUNK_NODES`` graph nodes per pass, the nodes a configuration runs being N_r + N_o, or N_r
+    for one-way networks) → ∂d̂/∂p_n by autograd on the robot node coordinates p_n (B, N, 2)
+    → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
+    (:meth:`~gdnplan.graph.RobotGraph.pullback`, float64). ``cross="soft_knn"`` networks run
+    :meth:`GraphDistNet.lean`, others the reference :meth:`GraphDistNet.forward`. The graphs of
+    a scene are built once per scene object (scenes are immutable) and cached. Results are
+    float64 numpy arrays. Inference runs with ``threads`` torch threads (None: the library
+    default, 1; :mod:`gdnplan.models.threads`), the caller's count restored after each call.
+    """
+
+    name = "graphdistnet"
+
+    def __init__(
+        self,
+        net: GraphDistNet,
+        card: dict | None = None,
+        chunk: int | None = None,
+        dtype: torch.dtype = torch.float32,
+        device: str | torch.device = "cpu",
+        threads: int | None = None,
+    ):
+        self.net = net.to(device, dtype).eval()
+        self.threads = check_threads(threads)
+        self.config = net.config
+        self.card = card or {}
+        self.chunk = chunk
+        self.dtype = dtype
+        self.device = torch.device(device)
+        self._scenes: weakref.WeakKeyDictionary[Scene, _SceneCache] = weakref.WeakKeyDictionary()
+
+    def check_scene(self, scene: Scene) -> None:
+        """InputError unless the weights were trained for ``scene``'s robot (models/checks.py)."""
+        check_fits(self.card, scene)
+
+    def _graphs(self, scene: Scene) -> _SceneCache:
+        """The (cached) robot graph, obstacle graph and lean scene graph of ``scene``."""
+        cached = self._scenes.get(scene)
+        if cached is None:
+            self.check_scene(scene)
+            graph = robot_graph(scene.robot, self.config.max_edge)
+            polys, sizes = scene_obstacles([scene])
+            obstacles = obstacle_graph(
+                polys, sizes, self.config.max_edge, device=self.device, dtype=self.dtype
+            )
+            lean = (
+                self.net.scene_graph(graph, obstacles) if self.config.cross == "soft_knn" else None
+            )
+            cached = self._scenes[scene] = _SceneCache(graph, obstacles, lean)
+        return cached
+
+    def _estimate(
+        self, graphs: _SceneCache, nodes: torch.Tensor, gen: torch.Generator | None
+    ) -> torch.Tensor:
+        """d̂ (B,) (m) of robot nodes (B, N_r, 2) (m)."""
+        if graphs.lean is not None:
+            return self.net.lean(nodes, graphs.lean)
+        robot = graphs.robot.batch(nodes, device=self.device, dtype=self.dtype)
+        return self.net(robot, _repeat(graphs.obstacles, len(nodes)), gen)
+
+    def _chunks(self, n: int, graphs: _SceneCache) -> list[slice]:
+        """n samples in ⌈n / chunk⌉ near-equal slices (77 → one, not 64 + 13: the fixed cost
+        per pass matters at the planner's batch sizes)."""
+        chunk = self.chunk
+        if chunk is None:
+            lean = graphs.lean
+            one_way = lean is not None and lean.fixed is not None
+            nodes = graphs.robot.n_nodes + (0 if one_way else graphs.obstacles.nodes.shape[1])
+            chunk = max(16, CHUNK_NODES // nodes)
+        edges = np.linspace(0, n, -(-n // chunk) + 1).round().astype(int)
+        return [slice(a, b) for a, b in itertools.pairwise(edges)]
+
+    def _generator(self) -> torch.Generator | None:
+        return torch.Generator().manual_seed(0) if self.config.cross == "argmax" else None
+
+    def _tensor(self, nodes: np.ndarray) -> torch.Tensor:
+        return torch.as_tensor(nodes, dtype=self.dtype, device=self.device)
+
+    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        """(B,) estimated signed distances (m) of q (B, dof) or (dof,)."""
+        q = scene.robot.check_q(q)
+        with torch_threads(self.threads):
+            graphs = self._graphs(scene)  # outside inference mode: the cache serves autograd too
+            gen = self._generator()
+            with torch.inference_mode():
+                out = [
+                    self._estimate(graphs, self._tensor(graphs.robot.positions(q[part])), gen)
+                    for part in self._chunks(len(q), graphs)
+                ]
+                return torch.cat(out).double().cpu().numpy()
+
+    def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad)."""
+        q = scene.robot.check_q(q)
+        with torch_threads(self.threads):
+            graphs = self._graphs(scene)
+            gen = self._generator()
+            ds, gs = [], []
+            for part in self._chunks(len(q), graphs):
+                taped = self._taped(graphs, q[part], gen)
+                ds.append(taped.d.detach())
+                gs.append(taped.grad(graphs.robot))
+        return torch.cat(ds).double().cpu().numpy(), np.concatenate(gs)
+
+    def distance_deferred_grad(
+        self, scene: Scene, q: np.ndarray
+    ) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
+        """d̂ (B,) (m) now and a function returning ∂d̂/∂q (B, dof) (m/rad) when called.
+
+        The forward pass keeps its autograd graph; the backward pass runs only if the gradient
+        is asked for (then once). A line search evaluates trial points it often rejects: they
+        cost the forward pass alone (about half of :meth:`distance_and_grad`). Meant for
+        planner-sized batches: every chunk's graph is held until the gradient is taken.
+        """
+        q = scene.robot.check_q(q)
+        threads = self.threads
+        with torch_threads(threads):
+            graphs = self._graphs(scene)
+            gen = self._generator()
+            tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
+
+        @functools.cache
+        def gradient() -> np.ndarray:
+            with torch_threads(threads):
+                return np.concatenate([t.grad(graphs.robot) for t in tapes])
+
+        return torch.cat([t.d.detach() for t in tapes]).double().cpu().numpy(), gradient
+
+    def _taped(self, graphs: _SceneCache, q: np.ndarray, gen: torch.Generator | None) -> _Tape:
+        """The forward pass of q (B, dof) with its autograd graph on the node coordinates."""
+        nodes, joints = graphs.robot.kinematics(q)
+        x = self._tensor(nodes).requires_grad_(True)
+        with torch.enable_grad():
+            d = self._estimate(graphs, x, gen)
+        return _Tape(nodes, joints, x, d)
+
+
+@dataclass(frozen=True)
+class _Tape:
+    """A forward pass awaiting its backward pass: node positions (B, N_r, 2) (m) and their
+    joints, the autograd leaf x (their tensor) and d̂ (B,)."""
+
+    nodes: np.ndarray
+    joints: np.ndarray
+    x: torch.Tensor
+    d: torch.Tensor
+
+    def grad(self, robot: RobotGraph) -> np.ndarray:
+        """∂d̂/∂q (B, dof): autograd to the node coordinates, then the robot's pullback."""
+        (dx,) = torch.autograd.grad(self.d.sum(), self.x)
+        return robot.pullback(self.nodes, self.joints, dx.double().cpu().numpy())
+
+
+@dataclass(frozen=True)
+class _SceneCache:
+    """The graphs of one scene: robot structure, obstacle graph (1, N_o), lean constants."""
+
+    robot: RobotGraph
+    obstacles: GraphBatch
+    lean: SceneGraph | None
+
+
+def _repeat(graph: GraphBatch, b: int) -> GraphBatch:
+    """A single graph (1, N) repeated B times (views, no copy)."""
+    parts = (graph.nodes, graph.prev, graph.next, graph.mask)
+    return GraphBatch(*(t.expand(b, *t.shape[1:]) for t in parts))
