@@ -1,0 +1,75 @@
+"""Trajectory optimisation: Problem, Plan, Ipopt direct transcription, the paper's Adam baseline.
+
+Direct transcription over T waypoints Q = (q_0, …, q_{T−1}), q_0 = start, q_{T−1} = goal:
+
+    minimise    Σ_t ‖q_{t+1} − q_t‖²                                   (the paper's path cost)
+    subject to  lower ≤ q_t ≤ upper,   |q_{t+1} − q_t| ≤ max_step      (joint, step limits)
+                d(p_k) ≥ margin           at the check points p = q_t + i/n_t (q_{t+1} − q_t),
+                                          i = 0 … n_t − 1, of every segment t (n_t = M + 1 first),
+                                          except the fixed start and goal themselves
+
+with d the overall or per-link distance of any DistanceModel (one batched call through
+:class:`~gdnplan.casadi_bridge.DistanceCallback`). The start and goal rows would be constants:
+coal checks both when the problem is made, and a learned model that rates one of them below
+the margin (the held stick 1.75 cm above its shelf) would only make the NLP infeasible.
+Continuous collision (the CCD certificate): after each solve, :func:`gdnplan.ccd.certify_path`
+checks the continuous motion with coal by conservative advancement; every waypoint segment it
+cannot certify gets twice as many check points (n_t ← 2 n_t) — and, for a learned model, the
+margin there and on ``raise_window`` segments either side is raised by the model's
+overestimate — and Ipopt re-solves from the current path, for ``refine_rounds`` rounds.
+(The certificate as NLP rows, d(p_k) + d(p_{k+1}) ≥ δ(p_k, p_{k+1}) + 2·margin, was tried and
+dropped: at 3 check points per segment δ reaches ~1 m on seed paths, the rows are infeasible
+and Ipopt runs to its iteration cap.) Ipopt uses a limited-memory Hessian and starts from the
+straight line when it is certified free (then it is already optimal and returned as is) or
+from RRT-Connect seeds, restarting from a new seed on failure. A plan succeeds only when
+:func:`gdnplan.ccd.verify_path` certifies the returned path with coal and the goal is reached —
+never on the solver's word alone.
+"""
+
+# ruff: noqa: F401  (the package's names, re-exported from the modules that define them)
+from __future__ import annotations
+
+from ..ccd import verify_path
+from .adam import collision_cost
+from .check_points import distance_bounds, model_overestimate, straight_line
+from .ik import first_joint_barrier, numeric_ik, tip_point, tip_position, tip_reach
+from .ipopt import SOLVER_ERRORS
+from .options import (
+    ADAM_INTERPOLATED,
+    INITIAL_GUESSES,
+    IPOPT_INTERPOLATED,
+    SOLVER_KEYS,
+    TrajoptOptions,
+)
+from .planner import checked, plan, resolve_model
+from .problem import Problem
+from .problem_file import (
+    GOAL_KEYS,
+    OPTION_KEYS,
+    START_KEYS,
+    TOP_KEYS,
+    problem_start,
+    read_problem_file,
+)
+from .result import Plan, path_cost
+from .transcription import WARM_START_OPTIONS
+
+# private helpers that cli.py and tests/test_trajopt.py import from here
+from .check_points import _check_point_raise, _near_segments, _path_parameters  # isort: skip
+from .problem_file import _no_unknown, _vector  # isort: skip
+from .transcription import _Transcription  # isort: skip
+
+__all__ = [
+    "Plan",
+    "Problem",
+    "TrajoptOptions",
+    "collision_cost",
+    "distance_bounds",
+    "first_joint_barrier",
+    "numeric_ik",
+    "path_cost",
+    "plan",
+    "straight_line",
+    "tip_position",
+    "verify_path",
+]

@@ -1,0 +1,75 @@
+"""The paper's baseline: Adam on the collision cost plus the path cost."""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+
+from ..ccd import certify_path
+from ..models import DistanceModel
+from .check_points import _interpolation_matrix, distance_bounds, straight_line
+from .options import ADAM_INTERPOLATED, _interpolated
+from .problem import Problem
+from .result import _Run
+
+log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
+
+
+def collision_cost(
+    d: np.ndarray, margin: float | np.ndarray, c: float, eps: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's C(d) = c / ((d − d_margin)² + ε) for d ≥ d_margin and its derivative.
+
+    Below the margin the paper's form would fall again (pushing deeper into collision), so
+    there C continues linearly with slope −c/ε per metre: C = c/ε + (c/ε)(d_margin − d)/√ε.
+    """
+    gap = d - margin
+    above = gap >= 0
+    slope = c / eps / math.sqrt(eps)
+    cost = np.where(above, c / (gap**2 + eps), c / eps - slope * gap)
+    dcost = np.where(above, -2 * c * gap / (gap**2 + eps) ** 2, -slope)
+    return cost, dcost
+
+
+def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -> _Run:
+    """Adam on the interior waypoints of Σ_k C(d(p_k)) + Σ_t ‖q_{t+1} − q_t‖², from the
+    straight line, until the collision cost falls below the threshold — every term below
+    C(margin + adam_stop), i.e. min_k d(p_k) ≥ margin + adam_stop as C decreases above the
+    margin — or the iteration cap. With ``ccd``, reaching the threshold triggers the continuous
+    certificate; uncertified segments get twice the check points and Adam continues. The
+    margin of each check point is that of :func:`distance_bounds` (relaxed next to an endpoint
+    a learned model rates below the margin)."""
+    T = problem.waypoints
+    splits = np.full(T - 1, _interpolated(opts, ADAM_INTERPOLATED) + 1)
+    W = _interpolation_matrix(splits)
+    slack = opts.adam_stop + 0.005  # the fixed endpoints must pass the stop test
+    lower = distance_bounds(problem, model, goal, splits, problem.margin, slack)
+    q = straight_line(problem.start, goal, T)
+    m, v = np.zeros_like(q), np.zeros_like(q)
+    b1, b2 = 0.9, 0.999
+    calls, refinements, status = 0, 0, "adam: iteration cap"
+    for it in range(1, opts.adam_iterations + 1):
+        d, g = model.distance_and_grad(problem.scene, W @ q)
+        calls += 1
+        if np.all(d >= lower + opts.adam_stop):
+            cert = certify_path(problem.scene, q) if opts.ccd else None
+            if cert is None or cert.ok or refinements == opts.refine_rounds:
+                status = "adam: cost below threshold"
+                break
+            splits[list(cert.bad_segments)] *= 2
+            W, refinements = _interpolation_matrix(splits), refinements + 1
+            lower = distance_bounds(problem, model, goal, splits, problem.margin, slack)
+            continue
+        _, dc = collision_cost(np.asarray(d), lower, opts.adam_c, opts.adam_eps)
+        grad = W.T @ (dc[:, None] * g)
+        grad[1:] += 2 * (q[1:] - q[:-1])
+        grad[:-1] -= 2 * (q[1:] - q[:-1])
+        grad[[0, -1]] = 0.0
+        m = b1 * m + (1 - b1) * grad
+        v = b2 * v + (1 - b2) * grad**2
+        step = opts.adam_lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
+        q = np.clip(q - step, problem.lower, problem.upper)
+    log.info("solve: %s, %d iterations", status, it)
+    return _Run(q=q, iterations=it, status=status, reason=status, model_calls=calls, attempts=1)

@@ -1,0 +1,116 @@
+"""The plan loop: :func:`plan` checks the settings, resolves the distance model, turns a goal
+position into a joint goal, runs the solver and certifies and times its path."""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from ..assets import default_weights
+from ..errors import InputError
+from ..limits import MAX_CHECK_POINTS
+from ..models import CoalModel, DistanceModel, load_model
+from ..scene import Scene
+from ..timing import limit_vector, plan_timing
+from .adam import _plan_adam
+from .ik import numeric_ik
+from .ipopt import _plan_ipopt
+from .options import ADAM_INTERPOLATED, IPOPT_INTERPOLATED, TrajoptOptions
+from .problem import Problem
+from .result import Plan, _finish
+
+log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
+
+
+def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | Path | None):
+    """The DistanceModel named by ``collision`` ("coal", "graphdistnet" or a model instance).
+
+    ``weights`` (GraphDistNet): shipped weights by name (``"d"``) or a ``.safetensors`` path;
+    None picks the shipped weights for the scene's robot and obstacles
+    (:func:`gdnplan.assets.default_weights`).
+    """
+    if not isinstance(collision, str):
+        if not isinstance(collision, DistanceModel):
+            raise InputError(
+                f"collision: expected 'coal', 'graphdistnet' or a DistanceModel, "
+                f"got {type(collision).__name__}"
+            )
+        return checked(collision, scene)
+    if collision == "coal":
+        return CoalModel()
+    if collision != "graphdistnet":
+        raise InputError(f"collision: unknown {collision!r}; choose 'coal' or 'graphdistnet'")
+    t0 = time.perf_counter()
+    name = default_weights(scene) if weights is None else weights
+    model = checked(load_model(name), scene)
+    log.info("model: %s loaded, %.2f s", name, time.perf_counter() - t0)
+    return model
+
+
+def checked(model: DistanceModel, scene: Scene) -> DistanceModel:
+    """``model`` after its ``check_scene(scene)``, where it has one (learned models: InputError
+    when their weights were trained for another robot), before any solver runs it."""
+    check = getattr(model, "check_scene", None)
+    if check is not None:
+        check(scene)
+    return model
+
+
+def plan(
+    problem: Problem,
+    collision: str | DistanceModel = "coal",
+    solver: str = "ipopt",
+    weights: str | Path | None = None,
+    seed: int = 0,
+    options: TrajoptOptions | None = None,
+    max_velocity=None,
+    max_acceleration=None,
+) -> Plan:
+    """Plan a trajectory for ``problem``; see :mod:`gdnplan.trajopt` for the formulation.
+
+    ``options`` default to the problem's own solver settings (``problem.solver``), else to
+    :class:`TrajoptOptions`' defaults. ``max_velocity`` (rad/s; default: the URDF's limits)
+    and ``max_acceleration`` (rad/s²; default None: velocity limits only), one number or one
+    per joint, time the certified path (:func:`gdnplan.timing.time_path`, ``Plan.times``).
+
+    Raises GdnplanError on bad input; a failed solve returns ``Plan(success=False, reason=…)``.
+    """
+    t0 = time.perf_counter()
+    opts = options or problem.solver or TrajoptOptions()
+    if not isinstance(opts, TrajoptOptions):
+        raise InputError(f"options: expected TrajoptOptions, got {type(opts).__name__}")
+    opts = replace(opts)  # re-runs the checks (a frozen dataclass can still be forged)
+    _check_sizes(problem, opts, solver)
+    dof = problem.scene.robot.dof
+    if max_velocity is not None:
+        max_velocity = limit_vector(max_velocity, dof, "max_velocity", "rad/s")
+    if max_acceleration is not None:
+        max_acceleration = limit_vector(max_acceleration, dof, "max_acceleration", "rad/s²")
+    model = resolve_model(collision, problem.scene, weights)
+    goal = problem.goal if problem.goal is not None else numeric_ik(problem, seed)
+    if solver == "ipopt":
+        run = _plan_ipopt(problem, model, goal, opts, seed)
+    elif solver == "adam":
+        run = _plan_adam(problem, model, goal, opts)
+    else:
+        raise InputError(f"solver: unknown {solver!r}; choose 'ipopt' or 'adam'")
+    result = _finish(problem, run, t0)
+    trajectory, note = plan_timing(
+        problem.scene, result.q, result.success, max_velocity, max_acceleration
+    )
+    reason = f"{result.reason}; {note}".strip("; ") if note else result.reason
+    return replace(result, trajectory=trajectory, reason=reason)
+
+
+def _check_sizes(problem: Problem, opts: TrajoptOptions, solver: str) -> None:
+    """InputError when the first solve would exceed ``MAX_CHECK_POINTS`` check points."""
+    default = IPOPT_INTERPOLATED if solver == "ipopt" else ADAM_INTERPOLATED
+    per_segment = (default if opts.interpolated is None else opts.interpolated) + opts.starts
+    total = (problem.waypoints - 1) * per_segment
+    if total > MAX_CHECK_POINTS:
+        raise InputError(
+            f"options.waypoints × solver.interpolated: {total} check points, the limit is "
+            f"{MAX_CHECK_POINTS}; use fewer waypoints or check points"
+        )

@@ -1,0 +1,187 @@
+"""The planning problem: :class:`Problem`, its checks (limits, feasibility of the start and
+goal) and its construction from a problem file."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..assets import problem_file
+from ..distance import signed_distance
+from ..errors import InfeasibleProblemError, InputError, ProblemFileError
+from ..limits import MAX_WAYPOINTS, check_int, check_number
+from ..robot import first_outside
+from ..scene import Scene, scene_from_config
+from .ik import first_joint_barrier, tip_reach
+from .options import TrajoptOptions
+from .problem_file import (
+    GOAL_KEYS,
+    OPTION_KEYS,
+    START_KEYS,
+    TOP_KEYS,
+    _no_unknown,
+    _solver_options,
+    _vector,
+    read_problem_file,
+)
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """A planning problem: move the robot of ``scene`` from ``start`` to a goal.
+
+    Attributes:
+        scene: robot and obstacles.
+        start: (dof,) start joint angles (rad).
+        goal: (dof,) goal joint angles (rad), or None when ``goal_position`` is given.
+        goal_position: (2,) end-effector goal in the plane (m), or None.
+        waypoints: 3 ≤ T ≤ ``limits.MAX_WAYPOINTS`` (500), waypoints including start and goal.
+        margin: required clearance d ≥ margin (m).
+        max_step: largest change of any joint between consecutive waypoints (rad).
+        goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
+        lower: (dof,) lower joint limits (rad), within the robot's; the robot's when None.
+        upper: (dof,) upper joint limits (rad), within the robot's; the robot's when None.
+        solver: the solver settings this problem needs (a problem file's ``[solver]`` table,
+            e.g. short RRT-Connect steps for a narrow passage); :func:`plan` uses them unless
+            it is given ``options``. None: the defaults.
+    """
+
+    scene: Scene
+    start: np.ndarray
+    goal: np.ndarray | None = None
+    goal_position: np.ndarray | None = None
+    waypoints: int = 20
+    margin: float = 0.02
+    max_step: float = 1.0
+    goal_tolerance: float = 1e-3
+    lower: np.ndarray = field(default=None)  # type: ignore[assignment]
+    upper: np.ndarray = field(default=None)  # type: ignore[assignment]
+    solver: TrajoptOptions | None = None
+
+    def __post_init__(self) -> None:
+        robot = self.scene.robot
+        set_ = object.__setattr__
+        set_(
+            self,
+            "lower",
+            _vector(robot.lower if self.lower is None else self.lower, robot.dof, "options.lower"),
+        )
+        set_(
+            self,
+            "upper",
+            _vector(robot.upper if self.upper is None else self.upper, robot.dof, "options.upper"),
+        )
+        set_(self, "start", _vector(self.start, robot.dof, "start.q"))
+        if (self.goal is None) == (self.goal_position is None):
+            raise InputError("goal: give exactly one of q (joint angles) or position ([x, y])")
+        if self.goal is not None:
+            set_(self, "goal", _vector(self.goal, robot.dof, "goal.q"))
+        else:
+            set_(self, "goal_position", _vector(self.goal_position, 2, "goal.position"))
+        check_int(self.waypoints, "options.waypoints", 3, MAX_WAYPOINTS)
+        check_number(self.margin, "options.margin")
+        check_number(self.max_step, "options.max_step", strict=True)
+        check_number(self.goal_tolerance, "options.goal_tolerance", strict=True)
+        self._check_limits()
+        if self.solver is not None and not isinstance(self.solver, TrajoptOptions):
+            raise InputError(f"solver: expected TrajoptOptions, got {type(self.solver).__name__}")
+        self._check_feasible()
+
+    def _check_limits(self) -> None:
+        """lower < upper, both within the robot's own joint limits."""
+        robot = self.scene.robot
+        for name, value in (("lower", self.lower), ("upper", self.upper)):
+            j = first_outside(value, robot.lower, robot.upper)
+            if j is not None:
+                raise InputError(
+                    f"options.{name}[{j}] = {value[j]:.4g} is outside the robot's joint range "
+                    f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}]; narrow it"
+                )
+        flat = np.flatnonzero(self.lower >= self.upper)
+        if flat.size:
+            j = int(flat[0])
+            raise InputError(f"options.lower[{j}] must be below options.upper[{j}]")
+
+    def _check_feasible(self) -> None:
+        """Start and goal inside the limits and clear of obstacles, goal position in reach."""
+        named = [("start.q", self.start)] + (
+            [("goal.q", self.goal)] if self.goal is not None else []
+        )
+        for name, q in named:
+            j = first_outside(q, self.lower, self.upper)
+            if j is not None:
+                raise InfeasibleProblemError(
+                    f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
+                    f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
+                )
+            d = float(signed_distance(self.scene, q)[0])
+            if d <= self.margin:
+                raise InfeasibleProblemError(
+                    f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m; "
+                    "move it away from the obstacles or lower options.margin"
+                )
+        if self.goal is not None:
+            blocked = first_joint_barrier(self.scene, self.start[0], self.goal[0])
+            if blocked is not None:
+                raise InfeasibleProblemError(
+                    f"start.q[0] -> goal.q[0]: the first link collides at joint 1 = {blocked:.3f} "
+                    "rad, which every motion between them must pass (joints do not wrap)"
+                )
+        if self.goal_position is not None:
+            robot = self.scene.robot
+            r = float(np.linalg.norm(self.goal_position - robot.chain.joint_origins[0]))
+            if r > tip_reach(robot):
+                raise InfeasibleProblemError(
+                    f"goal.position {self.goal_position.tolist()} is out of reach: {r:.3f} m "
+                    f"from the base, the tip reaches {tip_reach(robot):.3f} m"
+                )
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Problem:
+        """Load a problem file or a shipped problem by name (``"fetch_reach"``); the schema is
+        in ``docs/problem_file.md``. ProblemFileError names any bad field."""
+        cfg = read_problem_file(path)
+        try:
+            return cls.from_config(cfg, base_dir=problem_file(path).parent)
+        except ProblemFileError as e:
+            raise ProblemFileError(f"{path}: {e}") from e
+
+    @classmethod
+    def from_config(cls, cfg: dict, base_dir: str | Path | None = None) -> Problem:
+        """Problem from a parsed TOML mapping (see :meth:`from_toml`); relative paths in it
+        (``[robot] urdf``) start at ``base_dir``, the current directory when None."""
+        _no_unknown(cfg, TOP_KEYS, "top level")
+        for key in ("start", "goal"):
+            if not isinstance(cfg.get(key), dict):
+                raise ProblemFileError(f"[{key}]: missing table", schema=True)
+        _no_unknown(cfg["start"], START_KEYS, "[start]")
+        _no_unknown(cfg["goal"], GOAL_KEYS, "[goal]")
+        options = cfg.get("options", {})
+        if not isinstance(options, dict):
+            raise ProblemFileError("[options]: expected a table")
+        _no_unknown(options, OPTION_KEYS, "[options]")
+        solver = _solver_options(cfg.get("solver"))
+        try:
+            scene = scene_from_config(cfg, base_dir)
+        except TypeError as e:
+            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
+        goal = cfg["goal"]
+        if ("q" in goal) == ("position" in goal):
+            raise ProblemFileError(
+                "[goal]: give exactly one of q = [...] or position = [x, y]", schema=True
+            )
+        if "q" not in cfg["start"]:
+            raise ProblemFileError("[start] q: missing; give the start joint angles", schema=True)
+        try:
+            return cls(
+                scene=scene,
+                start=cfg["start"]["q"],
+                goal=goal.get("q"),
+                goal_position=goal.get("position"),
+                solver=solver,
+                **options,
+            )
+        except InputError as e:
+            raise ProblemFileError(str(e)) from e

@@ -1,0 +1,133 @@
+"""What a plan hands back: :class:`Plan`, the path cost, and the final coal certificate
+that judges a solver's path (:func:`_finish`)."""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..ccd import Certificate, certify_path
+from ..errors import InputError
+from ..timing import TimedTrajectory
+from .ik import tip_position
+from .problem import Problem
+
+log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """Result of :func:`plan`.
+
+    Attributes:
+        success: the certified coal check passed and the goal is reached.
+        q: (T, dof) waypoints (rad).
+        min_distance: proven lower bound on the coal signed distance over the whole continuous
+            path (m; the certificate of :func:`gdnplan.ccd.certify_path`, within 1 mm of the
+            path's true minimum); −inf when the certificate could not prove the path free.
+        sampled_min_distance: smallest coal distance over the configurations the certificate
+            checked (m): an upper bound on the path's minimum (the true minimum lies in
+            [min_distance, sampled_min_distance]).
+        solve_time: wall time of the whole call: seeds, solves, verification (s); the time
+            parametrisation after them is not included.
+        iterations: solver iterations summed over attempts.
+        status: the solver's last return status (Ipopt's, or "adam: …").
+        reason: why the plan failed (or which attempt succeeded).
+        path_cost: Σ_t ‖q_{t+1} − q_t‖² (rad²).
+        model_calls: batched distance-model calls made by the solver.
+        attempts: solver runs made.
+        trajectory: the time parametrisation of the certified path
+            (:class:`~gdnplan.timing.TimedTrajectory`) under the robot's URDF velocity limits (or
+            ``plan(max_velocity=…)``) and ``plan(max_acceleration=…)``; None for a failed plan
+            and for a robot without velocity limits (``reason`` says which joint).
+    """
+
+    success: bool
+    q: np.ndarray
+    min_distance: float
+    solve_time: float
+    iterations: int
+    status: str
+    reason: str
+    path_cost: float
+    model_calls: int
+    attempts: int
+    sampled_min_distance: float
+    trajectory: TimedTrajectory | None = None
+
+    @property
+    def times(self) -> np.ndarray | None:
+        """(T,) time of each waypoint of q (s), 0 first; None without a trajectory."""
+        return None if self.trajectory is None else self.trajectory.times
+
+    @property
+    def duration(self) -> float | None:
+        """Duration of the trajectory (s); None without one."""
+        return None if self.trajectory is None else self.trajectory.duration
+
+    def sample(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Times (N,) 0, dt, …, duration (s) and configurations q (N, dof) rad on the
+        trajectory (:meth:`gdnplan.timing.TimedTrajectory.sample`)."""
+        if self.trajectory is None:
+            raise InputError(
+                "sample: this plan has no trajectory (it failed, or the robot has no velocity "
+                "limits: see its reason)"
+            )
+        return self.trajectory.sample(dt)
+
+
+def path_cost(q: np.ndarray) -> float:
+    """Σ_t ‖q_{t+1} − q_t‖² of a (T, dof) path (rad²)."""
+    return float(np.sum(np.diff(q, axis=0) ** 2))
+
+
+@dataclass
+class _Run:
+    """What a solver hands back before verification."""
+
+    q: np.ndarray
+    iterations: int = 0
+    status: str = ""
+    reason: str = ""
+    model_calls: int = 0
+    attempts: int = 0
+    verified: Certificate | None = None  # the certificate of q at margin 0, when made
+
+
+def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
+    """Certify the path with coal, check the goal, package the Plan."""
+    cert = run.verified or certify_path(problem.scene, run.q, margin=0.0)
+    reached = _goal_error(problem, run.q[-1]) <= problem.goal_tolerance
+    reason = run.reason
+    if not cert.ok:
+        reason = (
+            f"{reason}; coal certificate failed: {cert.reason} "
+            f"(smallest checked distance {cert.min_distance:+.4f} m)"
+        )
+    elif not reached:
+        reason = f"{reason}; goal not reached"
+    verdict = f"ok, clearance ≥ {cert.lower_bound:+.4f} m" if cert.ok else "not proven"
+    log.info("certify: coal certificate %s%s", verdict, "" if reached else "; goal not reached")
+    return Plan(
+        success=bool(cert.ok and reached),
+        q=run.q,
+        min_distance=cert.lower_bound,
+        solve_time=time.perf_counter() - t0,
+        iterations=run.iterations,
+        status=run.status,
+        reason=reason.lstrip("; "),
+        path_cost=path_cost(run.q),
+        model_calls=run.model_calls,
+        attempts=run.attempts,
+        sampled_min_distance=cert.min_distance,
+    )
+
+
+def _goal_error(problem: Problem, q: np.ndarray) -> float:
+    """Joint-space (rad, ∞-norm) or end-effector (m) distance of q to the goal."""
+    if problem.goal is not None:
+        return float(np.max(np.abs(q - problem.goal)))
+    return float(np.linalg.norm(tip_position(problem.scene.robot, q)[0] - problem.goal_position))
