@@ -24,6 +24,19 @@ from .errors import (
     ProblemFileError,
     UnknownNameError,
 )
+from .registry import ROBOTS, SCENES
+
+# The built-in robots and scenes defined outside robot.py and scene.py, by the module that
+# registers each; imported on first lookup (gdnplan.registry), so the core never imports them.
+ROBOTS.declare(
+    {
+        "planar2": "gdnplan.planar",
+        "planar7": "gdnplan.planar",
+        "ur5e": "gdnplan.ur5e",
+        "ur5": "gdnplan.ur5e",
+    }
+)
+SCENES.declare({"fetch": "gdnplan.ur5e"})
 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and IDEs
     from .casadi_bridge import DistanceCallback

@@ -608,7 +608,7 @@ def train_command(
     if run_dir is not None:
         check_output_dir(run_dir, "--run-dir")
     if model == "clearancenet":
-        from .models.clearancenet import train_and_save
+        from .train_clearancenet import train_and_save
 
         card = train_and_save(env, time_budget or 120.0, patience, out)
         typer.echo(json.dumps({"env": env, **card["test"]}, indent=2))

@@ -82,6 +82,7 @@ from tqdm import tqdm
 from .distance import signed_distance, signed_distance_and_grad
 from .errors import InputError, UnknownNameError
 from .files import atomic_path, write_text
+from .geometry import pad_polygons
 from .robot import Robot, load_robot
 from .scene import ENV_ROBOT, Scene, clear_of_base, make_scene
 from .ur5e import GRIPPER_STATES, TABLE_V
@@ -172,19 +173,6 @@ class Dataset:
             arrays["obstacles"] = arrays["obstacles"].astype(np.float32)
         with atomic_path(path, "shard") as tmp, open(tmp, "wb") as f:
             np.savez_compressed(f, env=np.array(self.env), **arrays)
-
-
-def pad_polygons(polys: list[list[np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
-    """Stack per-sample polygon lists into (n, P, V, 2) zero-padded arrays and (n, P) sizes."""
-    n_poly = max(len(ps) for ps in polys)
-    n_vert = max(len(p) for ps in polys for p in ps)
-    out = np.zeros((len(polys), n_poly, n_vert, 2))
-    sizes = np.zeros((len(polys), n_poly), np.int32)
-    for i, ps in enumerate(polys):
-        for j, p in enumerate(ps):
-            out[i, j, : len(p)] = p
-            sizes[i, j] = len(p)
-    return out, sizes
 
 
 def env_robot(env: str) -> Robot:
@@ -504,16 +492,3 @@ def _join(parts: list[dict], n: int | None) -> Dataset:
 def split_dir(env: str, split: str, root: Path | str = DATA_DIR) -> Path:
     """``data/<env>/<split>``."""
     return Path(root) / env / split
-
-
-def main(argv: list[str] | None = None) -> None:
-    """``python -m gdnplan.data …``: the same as ``gdnplan generate …``."""
-    import sys
-
-    from .cli import run
-
-    run(["generate", *(sys.argv[1:] if argv is None else argv)])
-
-
-if __name__ == "__main__":
-    main()

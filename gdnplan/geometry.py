@@ -1,4 +1,5 @@
-"""2-D polygons: validation, convex hulls, squares, α-shapes, densification, convex decomposition.
+"""2-D polygons: validation, convex hulls, squares, α-shapes, densification, convex decomposition,
+zero-padded batches of polygon lists (:func:`pad_polygons`).
 
 Convention: a polygon is an ``(m, 2)`` float64 array of vertices in metres, counter-clockwise,
 without a repeated closing vertex.
@@ -250,3 +251,16 @@ def _drop_collinear(part: np.ndarray) -> np.ndarray:
 def polygon_distance(a: np.ndarray, b: np.ndarray) -> float:
     """Euclidean distance between two polygons (0 when they overlap), via shapely."""
     return float(Polygon(a).distance(Polygon(b)))
+
+
+def pad_polygons(polys: list[list[np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+    """Stack per-sample polygon lists into (n, P, V, 2) zero-padded arrays and (n, P) sizes."""
+    n_poly = max(len(ps) for ps in polys)
+    n_vert = max(len(p) for ps in polys for p in ps)
+    out = np.zeros((len(polys), n_poly, n_vert, 2))
+    sizes = np.zeros((len(polys), n_poly), np.int32)
+    for i, ps in enumerate(polys):
+        for j, p in enumerate(ps):
+            out[i, j, : len(p)] = p
+            sizes[i, j] = len(p)
+    return out, sizes

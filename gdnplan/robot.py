@@ -14,7 +14,9 @@ where ``p⁰`` and ``o_j⁰`` are the point and joint ``j`` at ``q = 0`` (2-D pl
 :class:`PlanarChain` evaluates both for a batch with a handful of numpy operations; Pinocchio
 stays the reference (``Robot.node_positions_pinocchio``) and a test proves the two equal.
 Robots are built from URDF files by :mod:`gdnplan.urdf_robot` (which checks that every
-planning joint turns about ``n``); this module keeps the registry of the shipped ones.
+planning joint turns about ``n``); this module looks robots up by name in the registry
+(:mod:`gdnplan.registry`), where :mod:`gdnplan.planar` and :mod:`gdnplan.ur5e` register the
+shipped ones.
 """
 
 from __future__ import annotations
@@ -27,8 +29,8 @@ from functools import cached_property
 import numpy as np
 import pinocchio as pin
 
-from .assets import robot_urdf
-from .errors import InputError, UnknownNameError
+from .errors import InputError
+from .registry import ROBOTS
 
 
 def rot2(theta: np.ndarray) -> np.ndarray:
@@ -351,44 +353,19 @@ def as_batch(q: np.ndarray, dof: int, name: str = "q") -> np.ndarray:
 
 
 # -------------------------------------------------------------------- registry
-_REGISTRY: dict[str, Callable[..., Robot]] = {}
-
-
 def register_robot(name: str) -> Callable:
     """Decorator registering a robot factory under ``name`` for :func:`load_robot`."""
-
-    def wrap(factory: Callable[..., Robot]) -> Callable[..., Robot]:
-        _REGISTRY[name] = factory
-        return factory
-
-    return wrap
-
-
-BUILTIN_MODULES = ("gdnplan.ur5e",)  # modules that register more built-in robots and scenes
-
-
-def load_builtins() -> None:
-    """Import the modules that register built-in robots and scenes outside robot.py and
-    scene.py (:mod:`gdnplan.ur5e`: the ur5e and ur5 robots, the fetch scene). The registries
-    call it on a name they do not know and when listing names, so ``import gdnplan`` need not
-    import them (pinocchio models, meshes)."""
-    import importlib
-
-    for module in BUILTIN_MODULES:
-        importlib.import_module(module)
+    return ROBOTS.register(name)
 
 
 def robot_names() -> list[str]:
-    load_builtins()
-    return sorted(_REGISTRY)
+    return ROBOTS.names()
 
 
 def robot_options(name: str) -> set[str]:
     """The options :func:`load_robot` takes for the registered robot ``name`` (its factory's
     keyword parameters, e.g. ``gripper`` for ur5e): the ``[robot]`` keys beyond ``name``."""
-    if name not in _REGISTRY:
-        raise UnknownNameError(f"robot: unknown name {name!r}; choose one of {robot_names()}")
-    return factory_options(_REGISTRY[name])
+    return factory_options(ROBOTS.get(name))
 
 
 def factory_options(factory: Callable) -> set[str]:
@@ -403,37 +380,12 @@ def load_robot(name: str, **options) -> Robot:
     Options are passed to the factory (e.g. ``gripper="holding", stick_length=0.3`` for ur5e).
     Results without options are cached: the same name returns the same object.
     """
-    if name not in _REGISTRY:
-        load_builtins()
-    if name not in _REGISTRY:
-        raise UnknownNameError(f"robot: unknown name {name!r}; choose one of {robot_names()}")
+    factory = ROBOTS.get(name)
     if options:
-        return _REGISTRY[name](**options)
+        return factory(**options)
     if name not in _CACHE:
-        _CACHE[name] = _REGISTRY[name]()
+        _CACHE[name] = factory()
     return _CACHE[name]
 
 
 _CACHE: dict[str, Robot] = {}
-
-
-def _planar(name: str) -> Robot:
-    from .urdf_robot import RobotSpec, load_urdf, robot_from_models
-
-    spec = RobotSpec(
-        urdf=robot_urdf(name),
-        planning_joints=tuple(f"joint{i}" for i in range(1, int(name[-1]) + 1)),
-    )
-    return robot_from_models(name, *load_urdf(spec), spec)
-
-
-@register_robot("planar2")
-def planar2() -> Robot:
-    """Two 0.6 m links, 0.06 m wide, joints limited to ±π: reach 1.2 m."""
-    return _planar("planar2")
-
-
-@register_robot("planar7")
-def planar7() -> Robot:
-    """Seven 0.3 m links, 0.06 m wide, joints limited to ±π: reach 2.1 m."""
-    return _planar("planar7")

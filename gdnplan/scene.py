@@ -35,7 +35,8 @@ from .geometry import (
     limit_vertices,
     square,
 )
-from .robot import Robot, factory_options, load_builtins, load_robot, robot_names, robot_options
+from .registry import SCENES
+from .robot import Robot, factory_options, load_robot, robot_names, robot_options
 
 MAX_OBSTACLES = 1000  # obstacle polygons of one scene
 MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
@@ -117,41 +118,26 @@ class Scene:
 
 
 # -------------------------------------------------------------------- generators
-_GENERATORS: dict[str, Callable[..., Scene]] = {}
-
-
 def register_scene(name: str) -> Callable:
     """Decorator registering ``factory(seed, **options) -> Scene`` for :func:`make_scene`."""
-
-    def wrap(factory: Callable[..., Scene]) -> Callable[..., Scene]:
-        _GENERATORS[name] = factory
-        return factory
-
-    return wrap
+    return SCENES.register(name)
 
 
 def scene_names() -> list[str]:
-    load_builtins()
-    return sorted(_GENERATORS)
+    return SCENES.names()
 
 
 def scene_options(name: str) -> set[str]:
     """The options :func:`make_scene` takes for the generator ``name`` besides ``seed`` (e.g.
     ``gripper`` for fetch): the ``[scene]`` keys beyond ``generator`` and ``seed``."""
-    if name not in _GENERATORS:
-        raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
-    return factory_options(_GENERATORS[name]) - {"seed"}
+    return factory_options(SCENES.get(name)) - {"seed"}
 
 
 def make_scene(name: str, seed: int = 0, **options) -> Scene:
     """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
-    if name not in _GENERATORS:
-        load_builtins()
-    if name not in _GENERATORS:
-        raise UnknownNameError(f"scene: unknown name {name!r}; choose one of {scene_names()}")
-    return _GENERATORS[name](seed=seed, **options)
+    return SCENES.get(name)(seed=seed, **options)
 
 
 ENV_ROBOT = {"a": "planar2", "b": "planar2", "c": "planar7", "d": "planar7", "e": "planar7"}
@@ -265,7 +251,7 @@ def scene_from_config(cfg: dict, base_dir: str | Path | None = None) -> Scene:
         generator = scene_cfg["generator"]
         if not isinstance(generator, str):
             raise ProblemFileError(f"[scene] generator: expected a name, got {generator!r}")
-        if generator in _GENERATORS:  # an unknown name is make_scene's UnknownNameError
+        if generator in SCENES:  # an unknown name is make_scene's UnknownNameError
             allowed = SCENE_KEYS | scene_options(generator)
             no_unknown_keys(scene_cfg, allowed, f"[scene] (generator {generator!r})")
         options = {k: v for k, v in scene_cfg.items() if k not in ("generator", "seed")}

@@ -42,9 +42,9 @@ from tqdm import tqdm
 
 from .data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from .errors import InputError
-from .evaluate import roc_auc, sha256_prefix, used_cosine_distances
 from .files import atomic_path
 from .graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, variant_graphs
+from .metrics import roc_auc, sha256_prefix, used_cosine_distances
 from .models.graphdistnet import GraphDistNet, GraphDistNetConfig, load_graphdistnet
 from .models.weights import read_card, read_weights, write_weights
 
@@ -557,16 +557,3 @@ def plot_losses(log: list[dict], path: Path, title: str) -> None:
 
 
 PRESETS = {"faithful": GraphDistNetConfig.faithful, "smooth": GraphDistNetConfig.smooth}
-
-
-def main(argv: list[str] | None = None) -> None:
-    """``python -m gdnplan.train …``: the same as ``gdnplan train …``."""
-    import sys
-
-    from .cli import run
-
-    run(["train", *(sys.argv[1:] if argv is None else argv)])
-
-
-if __name__ == "__main__":
-    main()

@@ -25,10 +25,9 @@ import pytest
 import tomli_w
 
 import gdnplan as gp
-from gdnplan import robot as robot_module
-from gdnplan import scene as scene_module
 from gdnplan.errors import SCHEMA_DOC
 from gdnplan.limits import IPOPT_OPTIONS
+from gdnplan.registry import ROBOTS, SCENES
 from gdnplan.robot import robot_names, robot_options
 from gdnplan.robot_file import DEFAULT_PLANE, URDF_KEYS
 from gdnplan.scene import OBSTACLE_KEYS, ROBOT_KEYS, SCENE_KEYS, scene_names, scene_options
@@ -151,9 +150,9 @@ def parser_default(row: Row):
         return defaults.get(row.key, inspect.Parameter.empty)
     factory = None
     if table == "robot" and name is not None:
-        factory = robot_module._REGISTRY[name]
+        factory = ROBOTS.get(name)
     elif table == "scene" and name is not None:
-        factory = scene_module._GENERATORS[name]
+        factory = SCENES.get(name)
     elif (table, row.key) == ("scene", "seed"):
         factory = gp.make_scene
     if factory is None:

@@ -13,10 +13,7 @@ the zero-padded vertices of every obstacle (P × V × 2, m). The obstacle count 
 are fixed per environment; that is ClearanceNet's limitation the paper discusses. Dropout p = 0.5
 after each hidden layer for (d) and (e) as in the paper; evaluation runs without dropout.
 
-Training (:func:`train`) minimises ((d̂ − f) / reach)² with Adam on the same ``data/<env>/train``
-split as GraphDistNet (10 % held out for validation, learning rate halved after 3 epochs without
-validation improvement, early stopping, wall-clock budget). It is a small loop of its own because
-:mod:`gdnplan.train` builds graph tensors for GraphDistNet only.
+Training: :mod:`gdnplan.train_clearancenet` (``gdnplan train --model clearancenet``).
 
 Weights: ``<path>.safetensors`` (state dict) + ``<path>.json`` card with ``"model":
 "clearancenet"`` and the config, loadable with :func:`load`.
@@ -24,9 +21,7 @@ Weights: ``<path>.safetensors`` (state dict) + ``<path>.json`` card with ``"mode
 
 from __future__ import annotations
 
-import json
 import math
-import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -34,8 +29,8 @@ import numpy as np
 import torch
 from torch import nn
 
-from ..data import Dataset, pad_polygons
 from ..errors import InputError
+from ..geometry import pad_polygons
 from ..scene import Scene, make_scene
 from .checks import build_net, card_config, check_count, check_fits, check_layout
 from .threads import check_threads, torch_threads
@@ -226,8 +221,9 @@ class ClearanceNetModel:
         q = scene.robot.check_q(q)
         return self._run(q, self._scene_vector(scene, len(q)), True)
 
-    def predict_dataset(self, ds: Dataset, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
-        """Every sample of ``ds`` with its own obstacles, in one batched pass."""
+    def predict_dataset(self, ds, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        """Every sample of ``ds`` (a :class:`gdnplan.data.Dataset`) with its own obstacles, in
+        one batched pass."""
         return self._run(ds.q, obstacle_vector(self.net.config, ds.obstacles, ds.sizes), grad)
 
     def save(self, path: Path | str) -> Path:
@@ -248,114 +244,3 @@ def load(path: Path | str, threads: int | None = None) -> ClearanceNetModel:
     check_count(len(config.hidden) or 1, len(tensors), "hidden", path)
     net = build_net(path, "ClearanceNet", lambda: ClearanceNet(config), tensors)
     return ClearanceNetModel(net, card, threads=threads)
-
-
-def train(
-    env: str,
-    train_set: Dataset,
-    config: ClearanceNetConfig | None = None,
-    batch: int = 256,
-    lr: float = 1e-3,
-    epochs: int = 200,
-    patience: int = 10,
-    time_budget: float | None = None,
-    seed: int = 0,
-) -> ClearanceNetModel:
-    """Adam on ((d̂ − f)/scale)², best validation epoch kept (see the module docstring).
-
-    Args:
-        env: environment (sets the input layout unless ``config`` is given).
-        train_set: training samples (10 % become the validation set).
-        time_budget: stop after this many seconds of training (s).
-
-    Returns:
-        The trained model; its card records the data size, epochs, time and validation MAE.
-    """
-    config = config or ClearanceNetConfig.for_env(env)
-    torch.manual_seed(seed)
-    order = np.random.default_rng(seed).permutation(len(train_set))
-    n_val = max(len(train_set) // 10, 1)
-    obst = obstacle_vector(config, train_set.obstacles, train_set.sizes)
-    q = torch.as_tensor(train_set.q, dtype=torch.float32)
-    o = torch.as_tensor(obst, dtype=torch.float32)
-    d = torch.as_tensor(train_set.d, dtype=torch.float32)
-    val, tr = torch.as_tensor(order[:n_val]), torch.as_tensor(order[n_val:])
-    net = ClearanceNet(config)
-    opt = torch.optim.Adam(net.parameters(), lr=lr)
-    best, best_state, stale, plateau, log = math.inf, None, 0, 0, []
-    start = time.perf_counter()
-    for epoch in range(epochs):
-        if stale >= patience or (time_budget and time.perf_counter() - start > time_budget):
-            break
-        net.train()
-        perm = tr[torch.as_tensor(np.random.default_rng([seed, epoch]).permutation(len(tr)))]
-        for s in range(0, len(perm), batch):
-            rows = perm[s : s + batch]
-            loss = ((net(q[rows], o[rows]) - d[rows]) / config.scale).square().mean()
-            opt.zero_grad()
-            loss.backward()
-            opt.step()
-        net.eval()
-        with torch.inference_mode():
-            val_mae = float((net(q[val], o[val]) - d[val]).abs().mean())
-        log.append({"epoch": epoch, "val_mae_m": val_mae, "lr": opt.param_groups[0]["lr"]})
-        if val_mae < best:
-            best, stale, plateau = val_mae, 0, 0
-            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
-        else:
-            stale, plateau = stale + 1, plateau + 1
-            if plateau >= 3:
-                plateau = 0
-                for g in opt.param_groups:
-                    g["lr"] /= 2
-    net.load_state_dict(best_state)
-    card = {
-        "env": env,
-        "data": {"train_dir": f"data/{env}/train", "n_train": len(tr), "n_val": n_val},
-        "training": {
-            "seed": seed,
-            "batch": batch,
-            "lr": lr,
-            "epochs": len(log),
-            "best_val_mae_m": best,
-            "seconds": time.perf_counter() - start,
-            "threads": torch.get_num_threads(),
-        },
-        "parameters": sum(p.numel() for p in net.parameters()),
-    }
-    return ClearanceNetModel(net, card)
-
-
-def train_and_save(
-    env: str, time_budget: float = 120.0, patience: int = 10, out: Path | str | None = None
-) -> dict:
-    """Train on ``data/<env>/train``, score on the test split, write ``weights/clearancenet_<env>``.
-
-    Returns the card (training log summary and test metrics: n, MAE (m), AUC, ACD).
-    """
-    from ..data import load, split_dir
-    from ..evaluate import evaluate_model
-
-    torch.set_num_threads(1)
-    model = train(env, load(split_dir(env, "train")), patience=patience, time_budget=time_budget)
-    r = evaluate_model(model, env, n=5000)
-    model.card["test"] = {"n": r.n, "mae_m": r.mae, "auc": r.auc, "acd": r.acd, "n_grad": r.n_grad}
-    model.card["command"] = (
-        f"python -m gdnplan.models.clearancenet {env} --time-budget {time_budget:g} "
-        f"--patience {patience}"
-    )
-    model.save(out or Path("weights") / f"clearancenet_{env}.safetensors")
-    return model.card
-
-
-if __name__ == "__main__":
-    import argparse
-
-    parser = argparse.ArgumentParser(description="Train ClearanceNet baselines (Table I).")
-    parser.add_argument("envs", nargs="+", choices=["a", "b", "c", "d", "e"])
-    parser.add_argument("--time-budget", type=float, default=120.0, help="seconds per env")
-    parser.add_argument("--patience", type=int, default=10, help="epochs without improvement")
-    args = parser.parse_args()
-    for env in args.envs:
-        card = train_and_save(env, args.time_budget, args.patience)
-        print(env, json.dumps({"training": card["training"], "test": card["test"]}))
