@@ -105,7 +105,16 @@ def imports(module: str, source: str, modules: set[str]) -> list[Import]:
         if target is not None and target != module and Import(module, target, line) not in found:
             found.append(Import(module, target, line))
 
-    for node in ast.walk(ast.parse(source)):
+    tree = ast.parse(source)
+    logger_names = {  # logging.getLogger("gdnplan.x") names a logger, not an import
+        id(call.args[0])
+        for call in ast.walk(tree)
+        if isinstance(call, ast.Call)
+        and isinstance(call.func, ast.Attribute)
+        and call.func.attr == "getLogger"
+        and call.args
+    }
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for alias in node.names:
                 add(alias.name, node.lineno)
@@ -119,7 +128,9 @@ def imports(module: str, source: str, modules: set[str]) -> list[Import]:
                 sub = f"{origin}.{alias.name}"
                 add(sub if sub in modules else origin, node.lineno)
         elif isinstance(node, ast.Constant) and isinstance(node.value, str):
-            if node.value in modules - {PACKAGE}:  # a module named by a string: imported on demand
+            if id(node) not in logger_names and node.value in modules - {
+                PACKAGE
+            }:  # a module named by a string: imported on demand
                 add(node.value, node.lineno)
     return found
 

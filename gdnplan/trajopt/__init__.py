@@ -32,7 +32,7 @@ from __future__ import annotations
 from ..ccd import verify_path
 from .adam import collision_cost
 from .check_points import distance_bounds, model_overestimate, straight_line
-from .ik import first_joint_barrier, numeric_ik, tip_point, tip_position, tip_reach
+from .ik import first_joint_barrier, tip_point, tip_position, tip_reach
 from .ipopt import SOLVER_ERRORS
 from .options import (
     ADAM_INTERPOLATED,
@@ -41,7 +41,7 @@ from .options import (
     SOLVER_KEYS,
     TrajoptOptions,
 )
-from .planner import checked, plan, resolve_model
+from .planner import checked, numeric_ik, plan, resolve_model
 from .problem import Problem
 from .problem_file import (
     GOAL_KEYS,

@@ -1,20 +1,15 @@
 """The end effector (the robot's last frame), what it can reach, and the numeric inverse
-kinematics that turns a problem's ``goal_position`` into a joint goal."""
+kinematics' building blocks (the planner's ``numeric_ik`` turns a ``goal_position`` into a
+joint goal)."""
 
 from __future__ import annotations
-
-from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
 from ..distance import signed_distance
-from ..errors import InfeasibleProblemError
 from ..robot import Robot
 from ..scene import Scene
-
-if TYPE_CHECKING:
-    from .problem import Problem
 
 
 def tip_point(robot: Robot) -> np.ndarray:
@@ -54,38 +49,3 @@ def first_joint_barrier(scene: Scene, a: float, b: float, n: int = 200) -> float
     d = signed_distance(scene, q, per_link=True)[:, first].min(axis=1)
     hit = np.flatnonzero(d <= 0)
     return float(q[hit[0], 0]) if hit.size else None
-
-
-def numeric_ik(
-    problem: Problem, seed: int = 0, restarts: int = 64, iterations: int = 100
-) -> np.ndarray:
-    """Collision-free joint goal (dof,) whose tip is at ``problem.goal_position``.
-
-    Batched damped least squares Δq = Jᵀ(JJᵀ + λ²I)⁻¹ e from the start and ``restarts`` random
-    configurations, clipped to the limits; among solutions within ``goal_tolerance`` and clear
-    of the margin, the one closest to the start. Raises InfeasibleProblemError if none exists.
-    """
-    robot, target = problem.scene.robot, problem.goal_position
-    rng = np.random.default_rng(seed)
-    q = np.vstack([problem.start, rng.uniform(problem.lower, problem.upper, (restarts, robot.dof))])
-    tip0, body = tip_point(robot)[None], np.array([robot.dof])
-    for _ in range(iterations):
-        p = robot.chain.transform(tip0, body, q)
-        jac = robot.chain.jacobian(p, body, q)[:, 0]  # (B, 2, dof)
-        err = target - p[:, 0]
-        jjt = jac @ np.swapaxes(jac, 1, 2) + 1e-4 * np.eye(2)
-        step = np.einsum("bji,bj->bi", jac, np.linalg.solve(jjt, err[..., None])[..., 0])
-        q = np.clip(q + step, problem.lower, problem.upper)
-    err = np.linalg.norm(tip_position(robot, q) - target, axis=1)
-    ok = err <= problem.goal_tolerance / 2
-    if ok.any():
-        ok[ok] = signed_distance(problem.scene, q[ok]) > problem.margin
-    for i in np.flatnonzero(ok):
-        ok[i] = first_joint_barrier(problem.scene, problem.start[0], q[i, 0], n=50) is None
-    if not ok.any():
-        raise InfeasibleProblemError(
-            f"goal.position {target.tolist()}: no collision-free joint configuration within the "
-            "limits reaches it; move the goal or lower options.margin"
-        )
-    candidates = q[ok]
-    return candidates[np.argmin(np.linalg.norm(candidates - problem.start, axis=1))]

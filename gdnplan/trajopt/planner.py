@@ -8,14 +8,17 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
 from ..assets import default_weights
-from ..errors import InputError
+from ..distance import signed_distance
+from ..errors import InfeasibleProblemError, InputError
 from ..limits import MAX_CHECK_POINTS
 from ..models import CoalModel, DistanceModel, load_model
 from ..scene import Scene
 from ..timing import limit_vector, plan_timing
 from .adam import _plan_adam
-from .ik import numeric_ik
+from .ik import first_joint_barrier, tip_point, tip_position
 from .ipopt import _plan_ipopt
 from .options import ADAM_INTERPOLATED, IPOPT_INTERPOLATED, TrajoptOptions
 from .problem import Problem
@@ -114,3 +117,38 @@ def _check_sizes(problem: Problem, opts: TrajoptOptions, solver: str) -> None:
             f"options.waypoints × solver.interpolated: {total} check points, the limit is "
             f"{MAX_CHECK_POINTS}; use fewer waypoints or check points"
         )
+
+
+def numeric_ik(
+    problem: Problem, seed: int = 0, restarts: int = 64, iterations: int = 100
+) -> np.ndarray:
+    """Collision-free joint goal (dof,) whose tip is at ``problem.goal_position``.
+
+    Batched damped least squares Δq = Jᵀ(JJᵀ + λ²I)⁻¹ e from the start and ``restarts`` random
+    configurations, clipped to the limits; among solutions within ``goal_tolerance`` and clear
+    of the margin, the one closest to the start. Raises InfeasibleProblemError if none exists.
+    """
+    robot, target = problem.scene.robot, problem.goal_position
+    rng = np.random.default_rng(seed)
+    q = np.vstack([problem.start, rng.uniform(problem.lower, problem.upper, (restarts, robot.dof))])
+    tip0, body = tip_point(robot)[None], np.array([robot.dof])
+    for _ in range(iterations):
+        p = robot.chain.transform(tip0, body, q)
+        jac = robot.chain.jacobian(p, body, q)[:, 0]  # (B, 2, dof)
+        err = target - p[:, 0]
+        jjt = jac @ np.swapaxes(jac, 1, 2) + 1e-4 * np.eye(2)
+        step = np.einsum("bji,bj->bi", jac, np.linalg.solve(jjt, err[..., None])[..., 0])
+        q = np.clip(q + step, problem.lower, problem.upper)
+    err = np.linalg.norm(tip_position(robot, q) - target, axis=1)
+    ok = err <= problem.goal_tolerance / 2
+    if ok.any():
+        ok[ok] = signed_distance(problem.scene, q[ok]) > problem.margin
+    for i in np.flatnonzero(ok):
+        ok[i] = first_joint_barrier(problem.scene, problem.start[0], q[i, 0], n=50) is None
+    if not ok.any():
+        raise InfeasibleProblemError(
+            f"goal.position {target.tolist()}: no collision-free joint configuration within the "
+            "limits reaches it; move the goal or lower options.margin"
+        )
+    candidates = q[ok]
+    return candidates[np.argmin(np.linalg.norm(candidates - problem.start, axis=1))]
