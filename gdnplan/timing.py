@@ -41,7 +41,7 @@ from .scene import Scene
 
 GRID_PER_SEGMENT = 8  # toppra grid cells per waypoint segment (fewer above MAX_GRID)
 MAX_GRID = 4000  # toppra grid points at most
-BEFORE_KNOT = (1e-6, 1e-3, 0.0)  # grid points this share of a segment before inner knots (0: none)
+BEFORE_KNOT = (1e-6, 1e-3, 1e-2, 0.0)  # grid points this share of a segment before inner knots
 STRETCH_SLACK = 1e-9  # c is raised by this fraction (rounding of the cell bounds)
 KINDS = ("linear", "smooth", "stop")
 
@@ -197,6 +197,11 @@ class _Smooth:
         self.u = (sd[1:] ** 2 - sd[:-1] ** 2) / (2 * dg)
         self.ts = np.concatenate([[0.0], np.cumsum(2 * dg / (sd[1:] + sd[:-1]))])
 
+    @property
+    def duration(self) -> float:
+        """Total time (s), the stretch included."""
+        return float(self.c * self.ts[-1])
+
     def at_grid(self, cell: np.ndarray, x: np.ndarray):
         """(s, ṡ, s̈) at time x after the start of grid cell ``cell`` (toppra's time)."""
         sd, u = self.sd[cell], self.u[cell]
@@ -240,13 +245,14 @@ def _toppra(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> _Smooth |
     m = max(2, min(GRID_PER_SEGMENT, MAX_GRID // (2 * segments)))
     cells = np.linspace(0.0, 1.0, m + 1)[:-1]
     cells = (knots[:-1, None] + cells[None] * np.diff(knots)[:, None]).ravel()
-    for offset in BEFORE_KNOT:  # the closest first; toppra may call it uncontrollable
+    best = None
+    for offset in BEFORE_KNOT:  # toppra may call one grid uncontrollable: the fastest one wins
         before = knots[1:-1] - offset * np.diff(knots)[:-1]  # p'' jumps at every knot
         grid = np.unique(np.concatenate([cells, before if offset else [], knots[-1:]]))
         prof = _toppra_on_grid(curve, knots, grid, v, a)
-        if prof is not None:
-            return prof
-    return None
+        if prof is not None and (best is None or prof.duration < best.duration):
+            best = prof
+    return best
 
 
 def _toppra_on_grid(curve, knots, grid, v, a) -> _Smooth | None:
@@ -286,33 +292,49 @@ def _toppra_on_grid(curve, knots, grid, v, a) -> _Smooth | None:
     return prof
 
 
-def cell_bounds(curve, grid: np.ndarray, sd: np.ndarray, u: np.ndarray):
-    """Upper bounds (cells, dof) of |q̇_j| and |q̈_j| over each grid cell [s_i, s_{i+1}].
+def max_abs_quadratic(a2, a1, a0, h0, h1):
+    """max |a2 h² + a1 h + a0| over h ∈ [h0, h1] (elementwise): the ends and the vertex."""
 
-    In a cell ṡ² is linear in s (s̈ = u constant), so ṡ ≤ max(ṡ_i, ṡ_{i+1}) and
-
-        |q̇_j| = |p'_j| ṡ ≤ P1 · max ṡ,    |q̈_j| = |p''_j ṡ² + p'_j s̈| ≤ P2 · max ṡ² + P1 |u|,
-
-    with P1 = max |p'_j| (a quadratic on the cell: its ends and its vertex) and P2 = max |p''_j|
-    (linear on the cell: its ends, taken on the cell's own cubic piece — p'' jumps at knots).
-    Every cell lies inside one piece of the PCHIP curve (the grid holds every knot).
-    """
-    piece = np.clip(np.searchsorted(curve.x, grid[:-1], side="right") - 1, 0, len(curve.x) - 2)
-    c3, c2, c1 = curve.c[0, piece], curve.c[1, piece], curve.c[2, piece]  # (cells, dof)
-    h0 = (grid[:-1] - curve.x[piece])[:, None]
-    h1 = (grid[1:] - curve.x[piece])[:, None]
-
-    def d1(h):
-        return 3 * c3 * h**2 + 2 * c2 * h + c1
+    def f(h):
+        return (a2 * h + a1) * h + a0
 
     with np.errstate(divide="ignore", invalid="ignore"):
-        vertex = np.where(c3 != 0, -c2 / (3 * c3), h0)
+        vertex = np.where(a2 != 0, -a1 / (2 * a2), h0)
     inside = (vertex > h0) & (vertex < h1)
-    p1 = np.maximum(np.abs(d1(h0)), np.abs(d1(h1)))
-    p1 = np.where(inside, np.maximum(p1, np.abs(d1(np.where(inside, vertex, h0)))), p1)
-    p2 = np.maximum(np.abs(6 * c3 * h0 + 2 * c2), np.abs(6 * c3 * h1 + 2 * c2))
-    top = np.maximum(sd[:-1], sd[1:])[:, None]
-    return p1 * top, p2 * top**2 + p1 * np.abs(u)[:, None]
+    ends = np.maximum(np.abs(f(h0)), np.abs(f(h1)))
+    return np.where(inside, np.maximum(ends, np.abs(f(np.where(inside, vertex, h0)))), ends)
+
+
+def cell_bounds(curve, grid: np.ndarray, sd: np.ndarray, u: np.ndarray, split: int = 8):
+    """Upper bounds (cells, dof) of |q̇_j| and |q̈_j| over each grid cell [s_i, s_{i+1}].
+
+    In a cell w = ṡ² is linear in s (s̈ = u constant). Each cell is cut into ``split`` equal
+    pieces [a, b], inside one cubic piece p_j(h) = c3 h³ + c2 h² + c1 h + c0 of the PCHIP curve
+    (h = s − its knot; the grid holds every knot; p'' jumps at knots, so each piece uses its
+    own cubic). On [a, b], with w = W0 + 2u h:
+
+        |q̇_j| = |p'_j| ṡ ≤ max |p'_j| · max(ṡ(a), ṡ(b))        (p'_j: a quadratic in h)
+        q̈_j = p''_j w + p'_j u = 15 u c3 h² + 6 (c3 W0 + u c2) h + 2 c2 W0 + u c1
+
+    — a quadratic in h, so max |q̈_j| is exact (its ends and its vertex). Finer pieces make the
+    velocity bound tighter, never unsafe.
+    """
+    cells = len(grid) - 1
+    frac = np.linspace(0.0, 1.0, split + 1)
+    s = grid[:-1, None] + frac[None] * np.diff(grid)[:, None]  # (cells, split + 1)
+    w = np.maximum(sd[:-1, None] ** 2 + 2 * u[:, None] * (s - grid[:-1, None]), 0.0)
+    cell_piece = np.searchsorted(curve.x, grid[:-1], side="right") - 1
+    piece = np.repeat(np.clip(cell_piece, 0, len(curve.x) - 2), split)
+    c3, c2, c1 = curve.c[0, piece], curve.c[1, piece], curve.c[2, piece]  # (cells·split, dof)
+    h0 = (s[:, :-1].ravel() - curve.x[piece])[:, None]
+    h1 = (s[:, 1:].ravel() - curve.x[piece])[:, None]
+    uu = np.repeat(u, split)[:, None]
+    w0 = w[:, :-1].ravel()[:, None] - 2 * uu * h0  # W0: w = W0 + 2u h on the piece
+    top = np.sqrt(np.maximum(w[:, :-1], w[:, 1:]).ravel())[:, None]
+    vel = max_abs_quadratic(3 * c3, 2 * c2, c1, h0, h1) * top
+    acc = max_abs_quadratic(15 * uu * c3, 6 * (c3 * w0 + uu * c2), 2 * c2 * w0 + uu * c1, h0, h1)
+    dof = c1.shape[1]
+    return vel.reshape(cells, split, dof).max(1), acc.reshape(cells, split, dof).max(1)
 
 
 def time_path(

@@ -294,3 +294,29 @@ def test_smooth_timing_without_toppra_says_how_to_install_it(free, monkeypatch):
     monkeypatch.setitem(sys.modules, "toppra", None)  # import toppra raises ImportError
     with pytest.raises(gp.InputError, match="pip install toppra"):
         time_path(np.array([[0.0, 0.0], [0.5, 0.2]]), 1.0, 2.0, free[2])
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**31), st.integers(1, 4), st.integers(2, 6))
+def test_cell_bounds_hold_and_the_acceleration_bound_is_exact(seed, dof, n):
+    """The per-cell bounds are ≥ the motion's |q̇|, |q̈| everywhere in the cell; |q̈|'s is its max."""
+    from scipy.interpolate import PchipInterpolator
+
+    from gdnplan.timing import cell_bounds
+
+    rng = np.random.default_rng(seed)
+    knots = np.concatenate([[0.0], np.cumsum(rng.uniform(0.1, 1.0, n - 1))])
+    curve = PchipInterpolator(knots, rng.uniform(-1, 1, (n, dof)), axis=0)
+    grid = np.unique(np.concatenate([knots, rng.uniform(0, knots[-1], 3 * n)]))
+    sd = rng.uniform(0.0, 2.0, len(grid))
+    u = (sd[1:] ** 2 - sd[:-1] ** 2) / (2 * np.diff(grid))
+    vel, acc = cell_bounds(curve, grid, sd, u)
+    for i in range(len(grid) - 1):
+        end = grid[i + 1] - 1e-12 * (grid[i + 1] - grid[i])  # the left limit: its own cubic
+        s = np.linspace(grid[i], end, 2001)
+        w = sd[i] ** 2 + 2 * u[i] * (s - grid[i])
+        qd = curve(s, 1) * np.sqrt(np.maximum(w, 0))[:, None]
+        qdd = curve(s, 2) * w[:, None] + curve(s, 1) * u[i]
+        assert np.all(np.abs(qd).max(0) <= vel[i] * (1 + 1e-9) + 1e-12)
+        assert np.all(np.abs(qdd).max(0) <= acc[i] * (1 + 1e-9) + 1e-12)
+        np.testing.assert_allclose(np.abs(qdd).max(0), acc[i], rtol=1e-3, atol=1e-9)
