@@ -31,10 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .assets import default_weights
 from .ccd import verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
-from .models import DistanceModel
+from .models import DistanceModel, load_model
 from .scene import Scene, make_scene
 from .timing import time_path, urdf_velocity
 from .trajopt import Plan, Problem, TrajoptOptions, plan
@@ -170,6 +171,9 @@ def run_fetch(
     scenes = fetch_scenes(seed)
     open_, held = scenes["open"], scenes["holding"]
     info = open_.info
+    if collision == "graphdistnet":  # load the weights once for every planned stage
+        collision = load_model(default_weights(open_) if weights is None else weights)
+        weights = None
     out = []
     for name in stages:
         if name == "approach":
