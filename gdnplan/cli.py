@@ -309,7 +309,8 @@ def json_number(x: float) -> float | None:
 
 
 def plan_summary(result, joint_names: list[str]) -> dict:
-    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none).
+    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none;
+    clearance: the clearance its certificate had to prove).
 
     ``t`` (s) is the time of each row of ``q`` (rad, columns in ``joint_names`` order), and
     ``timing`` its kind (:mod:`gdnplan.timing`); both null when the plan has no trajectory.
@@ -326,6 +327,7 @@ def plan_summary(result, joint_names: list[str]) -> dict:
         "timing": None if traj is None else traj.kind,
         "min_distance": json_number(result.min_distance),
         "sampled_min_distance": json_number(result.sampled_min_distance),
+        "clearance": float(result.clearance),
         "solve_time": float(result.solve_time),
         "iterations": int(result.iterations),
         "status": result.status,

@@ -16,8 +16,9 @@ bring_out    q_lift → q_out          holding   planned
 retreat      q_out → q_home          holding   planned
 ============ ======================= ========= =========================================
 
-Planned stages use ``margin`` (m) as the constraint d ≥ margin and are certified by the coal
-certificate of :func:`gdnplan.ccd.verify_path` (a proof of d > 0 on the continuous path). The
+Planned stages use ``margin`` (m) as their clearance: a planned stage succeeds when the coal
+certificate of :func:`gdnplan.ccd.certify_path` proves d > margin on the whole continuous path
+(:attr:`gdnplan.trajopt.Plan.success`). The
 lift is certified from its first point off the shelf (tcp ≥ 1 mm above it): its start is the
 contact the grasp makes by design.
 """

@@ -80,11 +80,12 @@ class Record:
     Attributes:
         setting, method, solver: which row of the table.
         problem: index of the problem in its setting.
-        success: certified coal check passed and goal reached.
+        success: the coal certificate proved the margin on the whole path and the goal is
+            reached.
         time: wall time of :func:`gdnplan.trajopt.plan` (s), model preparation excluded.
         prep_time: time to make the model for this problem (s): DiffCo's training, else 0.
         path_cost: Σ_t ‖q_{t+1} − q_t‖² (rad²).
-        min_distance: certified coal clearance of the path (m).
+        min_distance: certified coal clearance of the path (m): > the margin on success.
         status: the solver's status; reason: why it failed (or which attempt succeeded).
     """
 
@@ -288,9 +289,9 @@ def markdown(rows: list[Row]) -> str:
 NOTES = """\
 Notes:
 
-- Success: the certified coal check of the whole interpolated path (conservative advancement,
-  no robot point moves more than 1 mm unchecked) finds no contact and the goal is reached —
-  the same judge for every row; the solver's status is not trusted.
+- Success: the coal certificate of the whole continuous path (conservative advancement) proves
+  that it keeps the margin (signed distance > margin everywhere; before #22: > 0) and the goal
+  is reached — the same judge for every row; the solver's status is not trusted.
 - Path cost Σ_t ‖q_{t+1} − q_t‖² (rad²) over the problems every row of the setting solved
   ([n common]); the paper's fetch costs (≈ 10⁵) are on a scale we cannot reproduce from the text.
 - Times are wall times of `gdnplan.plan` on a shared 2-core CPU (seed paths, solves, the

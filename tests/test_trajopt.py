@@ -332,11 +332,12 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
     opts = TrajoptOptions(initial="rrt", refine_rounds=1, starts=1, raise_window=1)
     assert not plan(p, collision=_Liar(), options=opts).success
     (_, first), (splits, second) = margins
-    assert np.all(first == p.margin)
+    base = trajopt.check_points.constraint_margin(p, opts.clearance_buffer)  # margin + buffer
+    assert np.all(first == base)
     refined = np.flatnonzero(splits > splits.min())  # the segments coal rejected
     near = trajopt._near_segments(list(refined), len(splits), 1)
     expected_raised = trajopt._check_point_raise(splits, near.astype(float)) > 0
-    assert (second > p.margin).tolist() == expected_raised.tolist()
+    assert (second > base).tolist() == expected_raised.tolist()
     assert 0 < expected_raised.sum() < len(second)  # some check points keep the plain margin
 
 
@@ -355,6 +356,7 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
         ({"tol": float("nan")}, "tol"),
         ({"learned_margin": float("inf")}, "learned_margin"),
         ({"rrt_clearance": float("nan")}, "rrt_clearance"),
+        ({"clearance_buffer": -0.001}, "clearance_buffer"),
         ({"link_cap": -1.0}, "link_cap"),
         ({"rrt_time": -1.0}, "rrt_time"),
         ({"rrt_step": 0.0}, "rrt_step"),

@@ -4,26 +4,34 @@ Direct transcription over T waypoints Q = (q_0, …, q_{T−1}), q_0 = start, q_
 
     minimise    Σ_t ‖q_{t+1} − q_t‖²                                   (the paper's path cost)
     subject to  lower ≤ q_t ≤ upper,   |q_{t+1} − q_t| ≤ max_step      (joint, step limits)
-                d(p_k) ≥ margin           at the check points p = q_t + i/n_t (q_{t+1} − q_t),
+                d(p_k) ≥ m_c              at the check points p = q_t + i/n_t (q_{t+1} − q_t),
                                           i = 0 … n_t − 1, of every segment t (n_t = M + 1 first),
-                                          except the fixed start and goal themselves
+                                          except the fixed start and goal themselves,
+                                          m_c = max(margin, c + clearance_buffer)
 
 with d the overall or per-link distance of any DistanceModel (one batched call through
-:class:`~gdnplan.casadi_bridge.DistanceCallback`). The start and goal rows would be constants:
-coal checks both when the problem is made, and a learned model that rates one of them below
-the margin (the held stick 1.75 cm above its shelf) would only make the NLP infeasible.
+:class:`~gdnplan.casadi_bridge.DistanceCallback`) and c the certified clearance
+(:attr:`Problem.certified_clearance`: the margin unless ``Problem.clearance`` asks for less),
+the clearance the certificate must prove on the whole continuous path for a plan to succeed.
+The check points sit ``clearance_buffer`` (2 mm) above c because Ipopt leaves active rows a
+hair inside their bound, which a certificate at exactly that bound rejects. The start and goal
+rows would be constants: coal checks both when the problem is made (d > margin), and a learned
+model that rates one of them below the margin (the held stick 1.75 cm above its shelf) would
+only make the NLP infeasible.
 Continuous collision (the CCD certificate): after each solve, :func:`gdnplan.ccd.certify_path`
-checks the continuous motion with coal by conservative advancement; every waypoint segment it
-cannot certify gets twice as many check points (n_t ← 2 n_t) — and, for a learned model, the
-margin there and on ``raise_window`` segments either side is raised by the model's
-overestimate — and Ipopt re-solves from the current path, for ``refine_rounds`` rounds.
+checks the continuous motion with coal by conservative advancement at the clearance c; every
+waypoint segment it cannot certify gets twice as many check points (n_t ← 2 n_t) — and, for
+a learned model, the bound there and on ``raise_window`` segments either side is raised by
+the model's overestimate — and Ipopt re-solves from the current path, for ``refine_rounds``
+rounds.
 (The certificate as NLP rows, d(p_k) + d(p_{k+1}) ≥ δ(p_k, p_{k+1}) + 2·margin, was tried and
 dropped: at 3 check points per segment δ reaches ~1 m on seed paths, the rows are infeasible
 and Ipopt runs to its iteration cap.) Ipopt uses a limited-memory Hessian and starts from the
 straight line when it is certified free (then it is already optimal and returned as is) or
 from RRT-Connect seeds, restarting from a new seed on failure. A plan succeeds only when
-:func:`gdnplan.ccd.verify_path` certifies the returned path with coal and the goal is reached —
-never on the solver's word alone.
+:func:`gdnplan.ccd.certify_path` proves with coal that the whole returned path keeps d > c
+(``Plan.min_distance`` is that proven bound) and the goal is reached — never on the solver's
+word alone.
 """
 
 # ruff: noqa: F401  (the package's names, re-exported from the modules that define them)

@@ -54,7 +54,8 @@ def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -
         d, g = model.distance_and_grad(problem.scene, W @ q)
         calls += 1
         if np.all(d >= lower + opts.adam_stop):
-            cert = certify_path(problem.scene, q) if opts.ccd else None
+            clearance = problem.certified_clearance
+            cert = certify_path(problem.scene, q, clearance) if opts.ccd else None
             if cert is None or cert.ok or refinements == opts.refine_rounds:
                 status = "adam: cost below threshold"
                 break

@@ -62,6 +62,12 @@ def _check_point_raise(splits: np.ndarray, raised: np.ndarray) -> np.ndarray:
     return np.maximum(raised[lo], raised[hi])
 
 
+def constraint_margin(problem: Problem, buffer: float) -> float:
+    """The check points' bound d ≥ max(margin, certified clearance + buffer) (m): above the
+    clearance the certificate must prove (``TrajoptOptions.clearance_buffer``)."""
+    return max(problem.margin, problem.certified_clearance + buffer)
+
+
 def model_overestimate(
     scene: Scene, model: DistanceModel, q: np.ndarray, segments: list[int], margin: float
 ) -> float:

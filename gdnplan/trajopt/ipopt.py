@@ -15,7 +15,13 @@ from ..ccd import certify_path
 from ..distance import signed_distance
 from ..models import CoalModel, DistanceModel
 from ..rrt import seed_path
-from .check_points import _check_point_raise, _near_segments, model_overestimate, straight_line
+from .check_points import (
+    _check_point_raise,
+    _near_segments,
+    constraint_margin,
+    model_overestimate,
+    straight_line,
+)
 from .options import IPOPT_INTERPOLATED, TrajoptOptions, _count, _interpolated
 from .problem import Problem
 from .result import _Run
@@ -106,6 +112,9 @@ def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, 
 def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: _Run):
     """Solve, certify, refine, re-solve: (q, last stats, certified).
 
+    The check points demand d ≥ :func:`constraint_margin` (the margin, or the certified
+    clearance + ``opts.clearance_buffer`` if that is more); the certificate must prove
+    d > ``problem.certified_clearance`` on the whole continuous path.
     Each round that the coal certificate rejects doubles the check points of the rejected
     segments and, for a learned model, raises the constraint margin by the model's observed
     overestimate there (:func:`model_overestimate`) on the rejected segments and
@@ -121,7 +130,8 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
     splits = np.full(problem.waypoints - 1, opts.interpolated + 1)  # set by _plan_ipopt
     per_link = supports_per_link(model) if opts.per_link is None else opts.per_link
     learned = not isinstance(model, CoalModel)
-    margin = problem.margin + (opts.learned_margin if learned else 0.0)
+    base = constraint_margin(problem, opts.clearance_buffer)  # above the certified clearance
+    margin = base + (opts.learned_margin if learned else 0.0)
     raised = np.zeros(len(splits))  # margin raise of each segment (m)
     q, duals = guess, None
     for round_ in range(1 + (opts.refine_rounds if opts.ccd else 0)):
@@ -144,7 +154,7 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         if status in SOLVER_ERRORS or status.startswith("exception"):
             run.verified = None  # q is not a solver iterate: never accept it
             return q, stats, False
-        cert = certify_path(problem.scene, q, margin=0.0)
+        cert = certify_path(problem.scene, q, margin=problem.certified_clearance)
         run.verified = cert
         if cert.ok:
             return q, stats, True
@@ -155,6 +165,6 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         duals = nlp.duals_on(refined) if opts.warm_start else None
         splits = refined
         if learned:
-            over = model_overestimate(problem.scene, model, q, bad, problem.margin)
+            over = model_overestimate(problem.scene, model, q, bad, base)
             raised[_near_segments(bad, len(splits), opts.raise_window)] += over
     return q, stats, False

@@ -54,6 +54,11 @@ class TrajoptOptions:
             ≤ 1e-5): the certified check, not the KKT residual, judges the result. 1e-3 rather than
             1e-4 cut the Ipopt iterations of the (d) problems by 15 % (GraphDistNet) and 23 %
             (coal) for +0.1–0.3 % mean path cost (benchmarks/RESULTS.md).
+        clearance_buffer: the check points demand d ≥ max(margin, c + clearance_buffer) (m),
+            c the problem's certified clearance (``Problem.certified_clearance``, the margin by
+            default): Ipopt leaves active check points a hair inside their bound (d ≈ bound −
+            1e-8), which a certificate at exactly that bound rejects as a configuration within
+            it, and the buffer also leaves the path room to bend between check points.
         learned_margin: extra constraint margin (m) for learned models in the first solve;
             later rounds add the overestimate coal finds (see ``_solve_refined``).
         raise_window: a refine round raises a learned model's margin on the rejected
@@ -89,6 +94,7 @@ class TrajoptOptions:
     tol: float = 1e-3
     obj_change_tol: float = 1e-3
     rrt_clearance: float = 0.02
+    clearance_buffer: float = 0.002
     learned_margin: float = 0.0
     raise_window: int | None = 2
     rrt_time: float = 5.0
@@ -120,7 +126,7 @@ class TrajoptOptions:
         for name in ("tol", "obj_change_tol", "rrt_step", "link_cap", "adam_lr", "adam_c"):
             check_number(getattr(self, name), name, strict=True)
         check_number(self.adam_eps, "adam_eps", strict=True)
-        for name in ("rrt_clearance", "learned_margin", "adam_stop"):
+        for name in ("rrt_clearance", "clearance_buffer", "learned_margin", "adam_stop"):
             check_number(getattr(self, name), name)
         if check_number(self.rrt_time, "rrt_time", strict=True) > MAX_RRT_TIME:
             raise InputError(f"rrt_time: {self.rrt_time} s is over the limit {MAX_RRT_TIME} s")

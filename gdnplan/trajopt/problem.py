@@ -3,15 +3,17 @@ goal) and its construction from a problem file."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..assets import problem_file
+from ..ccd import proven_distance
 from ..distance import signed_distance
 from ..errors import InfeasibleProblemError, InputError, ProblemFileError
-from ..limits import MAX_WAYPOINTS, check_int, check_number
+from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number
 from ..robot import first_outside
 from ..scene import Scene, scene_from_config
 from .ik import first_joint_barrier, tip_reach
@@ -38,7 +40,9 @@ class Problem:
         goal: (dof,) goal joint angles (rad), or None when ``goal_position`` is given.
         goal_position: (2,) end-effector goal in the plane (m), or None.
         waypoints: 3 ≤ T ≤ ``limits.MAX_WAYPOINTS`` (500), waypoints including start and goal.
-        margin: required clearance d ≥ margin (m).
+        margin: required clearance (m): the NLP keeps d ≥ margin at its check points, and a
+            successful plan is proven to keep d > ``certified_clearance`` (the margin unless
+            ``clearance`` asks for less) on the whole continuous path.
         max_step: largest change of any joint between consecutive waypoints (rad).
         goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
         lower: (dof,) lower joint limits (rad), within the robot's; the robot's when None.
@@ -46,6 +50,10 @@ class Problem:
         solver: the solver settings this problem needs (a problem file's ``[solver]`` table,
             e.g. short RRT-Connect steps for a narrow passage); :func:`plan` uses them unless
             it is given ``options``. None: the defaults.
+        clearance: the clearance (m) a successful plan's coal certificate must prove along the
+            whole continuous path, 0 ≤ clearance ≤ margin; None: the margin. Ask for less than
+            the margin (e.g. 0: proven collision-free) to accept paths that dip below the
+            margin between check points.
     """
 
     scene: Scene
@@ -59,6 +67,13 @@ class Problem:
     lower: np.ndarray = field(default=None)  # type: ignore[assignment]
     upper: np.ndarray = field(default=None)  # type: ignore[assignment]
     solver: TrajoptOptions | None = None
+    clearance: float | None = None
+
+    @property
+    def certified_clearance(self) -> float:
+        """The clearance a successful plan is proven to keep (m): ``clearance``, or the margin
+        when it is None."""
+        return self.margin if self.clearance is None else self.clearance
 
     def __post_init__(self) -> None:
         robot = self.scene.robot
@@ -82,12 +97,30 @@ class Problem:
             set_(self, "goal_position", _vector(self.goal_position, 2, "goal.position"))
         check_int(self.waypoints, "options.waypoints", 3, MAX_WAYPOINTS)
         check_number(self.margin, "options.margin")
+        self._check_clearance()
         check_number(self.max_step, "options.max_step", strict=True)
         check_number(self.goal_tolerance, "options.goal_tolerance", strict=True)
         self._check_limits()
         if self.solver is not None and not isinstance(self.solver, TrajoptOptions):
             raise InputError(f"solver: expected TrajoptOptions, got {type(self.solver).__name__}")
         self._check_feasible()
+
+    def _check_clearance(self) -> None:
+        """clearance: None or a finite number in [0, margin]."""
+        if self.clearance is None:
+            return
+        if not (is_number(self.clearance) and math.isfinite(self.clearance)):
+            raise InputError(
+                f"options.clearance: expected a finite number in [0, margin] (m), got "
+                f"{self.clearance!r}; leave it out to certify the margin"
+            )
+        if not 0 <= self.clearance <= self.margin:
+            raise InputError(
+                f"options.clearance: {self.clearance!r} m is outside [0, options.margin = "
+                f"{self.margin!r} m]; the certified clearance is at most the margin (raise "
+                "options.margin, or leave clearance out to certify the margin)"
+            )
+        object.__setattr__(self, "clearance", float(self.clearance))
 
     def _check_limits(self) -> None:
         """lower < upper, both within the robot's own joint limits."""
@@ -117,7 +150,7 @@ class Problem:
                     f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
                 )
             d = float(signed_distance(self.scene, q)[0])
-            if d <= self.margin:
+            if d <= self.margin or proven_distance(d) <= self.certified_clearance:
                 raise InfeasibleProblemError(
                     f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m; "
                     "move it away from the obstacles or lower options.margin"

@@ -24,7 +24,9 @@ from .options import SOLVER_KEYS, TrajoptOptions
 TOP_KEYS = frozenset({"robot", "scene", "obstacles", "start", "goal", "options", "solver"})
 START_KEYS = frozenset({"q"})
 GOAL_KEYS = frozenset({"q", "position"})  # exactly one of them
-OPTION_KEYS = frozenset({"waypoints", "margin", "max_step", "goal_tolerance", "lower", "upper"})
+OPTION_KEYS = frozenset(
+    {"waypoints", "margin", "clearance", "max_step", "goal_tolerance", "lower", "upper"}
+)
 
 
 def read_problem_file(path: str | Path) -> dict:

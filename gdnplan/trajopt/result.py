@@ -23,7 +23,9 @@ class Plan:
     """Result of :func:`plan`.
 
     Attributes:
-        success: the certified coal check passed and the goal is reached.
+        success: the goal is reached and the coal certificate proves that the whole continuous
+            path keeps a signed distance > ``clearance`` (the problem's certified clearance:
+            its margin unless ``Problem.clearance`` asks for less), not only at check points.
         q: (T, dof) waypoints (rad).
         min_distance: proven lower bound on the coal signed distance over the whole continuous
             path (m; the certificate of :func:`gdnplan.ccd.certify_path`, within 1 mm of the
@@ -39,6 +41,8 @@ class Plan:
         path_cost: Σ_t ‖q_{t+1} − q_t‖² (rad²).
         model_calls: batched distance-model calls made by the solver.
         attempts: solver runs made.
+        clearance: the clearance the certificate was asked to prove (m,
+            ``Problem.certified_clearance``); on success min_distance > clearance.
         trajectory: the time parametrisation of the certified path
             (:class:`~gdnplan.timing.TimedTrajectory`) under the robot's URDF velocity limits (or
             ``plan(max_velocity=…)``) and ``plan(max_acceleration=…)``; None for a failed plan
@@ -56,6 +60,7 @@ class Plan:
     model_calls: int
     attempts: int
     sampled_min_distance: float
+    clearance: float = 0.0
     trajectory: TimedTrajectory | None = None
 
     @property
@@ -94,17 +99,18 @@ class _Run:
     reason: str = ""
     model_calls: int = 0
     attempts: int = 0
-    verified: Certificate | None = None  # the certificate of q at margin 0, when made
+    verified: Certificate | None = None  # q's certificate at the certified clearance, if made
 
 
 def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
     """Certify the path with coal, check the goal, package the Plan."""
-    cert = run.verified or certify_path(problem.scene, run.q, margin=0.0)
+    clearance = problem.certified_clearance
+    cert = run.verified or certify_path(problem.scene, run.q, margin=clearance)
     reached = _goal_error(problem, run.q[-1]) <= problem.goal_tolerance
     reason = run.reason
     if not cert.ok:
         reason = (
-            f"{reason}; coal certificate failed: {cert.reason} "
+            f"{reason}; coal certificate of clearance > {clearance:g} m failed: {cert.reason} "
             f"(smallest checked distance {cert.min_distance:+.4f} m)"
         )
     elif not reached:
@@ -123,6 +129,7 @@ def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
         model_calls=run.model_calls,
         attempts=run.attempts,
         sampled_min_distance=cert.min_distance,
+        clearance=clearance,
     )
 
 

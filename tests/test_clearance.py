@@ -1,0 +1,98 @@
+"""The margin is a promise (#22): a successful plan is proven to keep its requested clearance
+(the margin unless ``[options] clearance`` asks for less) along the whole continuous path."""
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+import gdnplan as gp
+from gdnplan.assets import problem_names
+from gdnplan.ccd import certify_path
+from gdnplan.cli import plan_summary
+from gdnplan.trajopt import Problem, TrajoptOptions, plan
+from gdnplan.trajopt.check_points import constraint_margin
+from gdnplan.trajopt.result import _finish, _Run
+
+SLOW = {"fetch_bring_out"}  # ~7 s with coal, over a minute with GraphDistNet
+
+
+def _check_kept(problem: Problem, result) -> None:
+    assert result.success, result.reason
+    assert result.clearance == problem.certified_clearance == problem.margin
+    assert result.min_distance > problem.margin  # the proven bound, not bound − margin
+    cert = certify_path(problem.scene, result.q, problem.margin)
+    assert cert.ok and cert.lower_bound > problem.margin
+
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.slow) if n in SLOW else n for n in problem_names()],
+)
+def test_every_shipped_problem_keeps_its_margin_with_coal(name):
+    problem = Problem.from_toml(name)
+    _check_kept(problem, plan(problem, collision="coal"))
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        n if n == "planar2_square" else pytest.param(n, marks=pytest.mark.slow)
+        for n in problem_names()
+    ],
+)
+def test_every_shipped_problem_keeps_its_margin_with_graphdistnet(name):
+    problem = Problem.from_toml(name)
+    _check_kept(problem, plan(problem, collision="graphdistnet"))
+
+
+def test_clearance_zero_certifies_collision_freedom_only():
+    default = Problem.from_toml("planar2_square")
+    cfg = gp.trajopt.read_problem_file("planar2_square")
+    cfg["options"]["clearance"] = 0.0
+    zero = Problem.from_config(cfg)
+    assert zero.clearance == zero.certified_clearance == 0.0 and zero.margin == default.margin
+    result = plan(zero, collision="coal")
+    assert result.success and result.clearance == 0.0 and result.min_distance > 0.0
+    assert plan_summary(result, ["a", "b"])["clearance"] == 0.0
+    # at clearance 0 the check points keep the margin; between them the path may dip below it
+    assert constraint_margin(zero, TrajoptOptions().clearance_buffer) == zero.margin
+    # this path (what the old rule, a certificate of d > 0, accepted) dips below the margin:
+    # certified at the margin, the default problem refuses it
+    assert 0.0 < result.min_distance < default.margin
+    refused = _finish(default, _Run(q=result.q, reason="given"), time.perf_counter())
+    assert not refused.success and math.isinf(refused.min_distance)
+    assert "clearance > 0.02 m failed" in refused.reason
+
+
+@pytest.mark.parametrize("value", [-0.01, 0.03, float("nan"), float("inf"), True, "0.01"])
+def test_bad_clearance_is_refused_naming_the_setting(value):
+    cfg = gp.trajopt.read_problem_file("planar2_square")  # margin 0.02
+    cfg["options"]["clearance"] = value
+    with pytest.raises(gp.ProblemFileError, match=r"options\.clearance"):
+        Problem.from_config(cfg)
+    base = Problem.from_toml("planar2_square")
+    with pytest.raises(gp.InputError, match=r"options\.clearance"):
+        Problem(scene=base.scene, start=base.start, goal=base.goal, clearance=value)
+
+
+def test_clearance_equal_to_the_margin_is_the_default():
+    base = Problem.from_toml("planar2_square")
+    same = Problem(scene=base.scene, start=base.start, goal=base.goal, clearance=0.02)
+    assert same.certified_clearance == base.certified_clearance == 0.02
+    assert constraint_margin(base, 0.002) == pytest.approx(0.022)
+
+
+def test_without_a_buffer_the_refine_rounds_still_never_accept_less_than_the_margin():
+    problem = Problem.from_toml("planar7_d")
+    opts = TrajoptOptions(clearance_buffer=0.0, refine_rounds=1, starts=1, initial="rrt")
+    result = plan(problem, collision="coal", options=opts)
+    # check points at exactly the margin: active rows end a hair inside it, so the
+    # certificate at the margin rejects them; success, if any, is still proven
+    assert not result.success or result.min_distance > problem.margin
+    if not result.success:
+        assert "clearance > 0.02 m failed" in result.reason
+    cert = certify_path(problem.scene, result.q, problem.margin)
+    assert cert.ok == result.success
+    assert np.all(result.q[[0, -1]] == [problem.start, problem.goal])
