@@ -32,14 +32,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .assets import default_weights
 from .ccd import verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
-from .models import DistanceModel, load_model
+from .models import DistanceModel
 from .scene import Scene, make_scene
 from .timing import time_path, urdf_velocity
-from .trajopt import Plan, Problem, TrajoptOptions, plan
+from .trajopt import Plan, Problem, TrajoptOptions, plan, resolve_model
 from .ur5e import LIFT, solve_ik
 
 log = logging.getLogger(__name__)  # one INFO line per finished stage
@@ -172,9 +171,8 @@ def run_fetch(
     scenes = fetch_scenes(seed)
     open_, held = scenes["open"], scenes["holding"]
     info = open_.info
-    if collision == "graphdistnet":  # load the weights once for every planned stage
-        collision = load_model(default_weights(open_) if weights is None else weights)
-        weights = None
+    if isinstance(collision, str):  # resolve (load weights) once for every planned stage
+        collision, weights = resolve_model(collision, open_, weights), None
     out = []
     for name in stages:
         if name == "approach":

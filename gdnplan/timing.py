@@ -197,11 +197,6 @@ class _Smooth:
         self.u = (sd[1:] ** 2 - sd[:-1] ** 2) / (2 * dg)
         self.ts = np.concatenate([[0.0], np.cumsum(2 * dg / (sd[1:] + sd[:-1]))])
 
-    @property
-    def duration(self) -> float:
-        """Total time (s), the stretch included."""
-        return float(self.c * self.ts[-1])
-
     def at_grid(self, cell: np.ndarray, x: np.ndarray):
         """(s, ṡ, s̈) at time x after the start of grid cell ``cell`` (toppra's time)."""
         sd, u = self.sd[cell], self.u[cell]
@@ -245,14 +240,13 @@ def _toppra(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> _Smooth |
     m = max(2, min(GRID_PER_SEGMENT, MAX_GRID // (2 * segments)))
     cells = np.linspace(0.0, 1.0, m + 1)[:-1]
     cells = (knots[:-1, None] + cells[None] * np.diff(knots)[:, None]).ravel()
-    best = None
-    for offset in BEFORE_KNOT:  # toppra may call one grid uncontrollable: the fastest one wins
+    for offset in BEFORE_KNOT:  # the closest first; toppra may call a grid uncontrollable
         before = knots[1:-1] - offset * np.diff(knots)[:-1]  # p'' jumps at every knot
         grid = np.unique(np.concatenate([cells, before if offset else [], knots[-1:]]))
         prof = _toppra_on_grid(curve, knots, grid, v, a)
-        if prof is not None and (best is None or prof.duration < best.duration):
-            best = prof
-    return best
+        if prof is not None:
+            return prof
+    return None
 
 
 def _toppra_on_grid(curve, knots, grid, v, a) -> _Smooth | None:
