@@ -68,7 +68,7 @@ def test_acd_and_its_standard_error_of_one_flipped_gradient():
 
 def test_timed_returns_result_and_positive_time():
     out, seconds = ev.timed(lambda: sum(range(1000)), repeats=3)
-    assert out == 499500 and 0 < seconds < 1
+    assert out == 499500 and 0 < seconds < float("inf")  # a duration, not a timing bound
 
 
 def test_coal_scores_perfectly_on_random_env():

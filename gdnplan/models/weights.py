@@ -77,7 +77,9 @@ def read_card(path: Path | str, what: str = "weights") -> dict:
     """The JSON card of the weights ``path``, checked against the tensors file (module
     docstring); InputError (prefixed by ``what``) when missing or not the pair's card."""
     if not Path(path).is_file():
-        raise InputError(f"{what}: {path} does not exist (give a .safetensors file or a name)")
+        raise InputError(
+            f"{what}: {path} does not exist or is not a file (give a .safetensors file or a name)"
+        )
     card = card_path(path)
     if not card.exists():
         raise InputError(f"{what}: no card {card.name} beside {path}")
