@@ -1,15 +1,16 @@
-"""Seconds for 5 000 configurations of coal signed distance (and + exact gradient) per environment.
+"""coal signed distance (and + exact gradient) for a batch of configurations, per environment.
 
-Usage: python benchmarks/coal_distance.py [--n 5000] [--repeats 3]
-Prints a markdown table: one core vs all cores, side by side in one run (best of the repeats).
+On each environment's scene (seed 0) and n uniformly random configurations (seed 0): coal's
+signed distance on one core, distance + exact gradient on one core, and distance + gradient over
+all cores (``gdnplan.distance`` splits batches of at least ``PARALLEL_MIN_BATCH`` over forked
+workers), side by side in one run: best of the repeats after one warm-up call each.
+
+    python benchmarks/coal_distance.py --threads 1 [--n 5000] [--repeats 3]
 """
 
 from __future__ import annotations
 
-import argparse
-import os
-import platform
-import time
+import common
 
 import gdnplan as gp
 from gdnplan import distance
@@ -17,37 +18,45 @@ from gdnplan import distance
 ENVS = ["a", "b", "c", "d", "e"]
 
 
-def best_time(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
-
-
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--n", type=int, default=5000)
-    parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
-    machine = platform.processor() or platform.machine()
-    print(f"machine: {machine}, {os.cpu_count()} cores; n = {args.n}")
-    print(
-        "| env | distance, 1 core (s) | distance + grad, 1 core (s) "
-        "| distance + grad, all cores (s) | µs / config (all cores) |"
+    p = common.parser("coal_distance", __doc__)
+    p.add_argument("--n", type=int, default=5000)
+    p.add_argument("--repeats", type=int, default=3)
+    args = common.parse(p)
+    report = common.Report(args, "coal ground truth", common.first_paragraph(__doc__))
+    report.text(f"{args.n} configurations per environment, best of {args.repeats} (s).")
+    table = report.table(
+        "env",
+        "distance, 1 core (s)",
+        "distance + grad, 1 core (s)",
+        "distance + grad, all cores (s)",
+        "µs / config (all cores)",
     )
-    print("|---|---|---|---|---|")
+    parallel = distance.PARALLEL_MIN_BATCH
     for env in ENVS:
         scene = gp.make_scene(env, seed=0)
         q = scene.robot.sample(args.n, seed=0)
         distance.checker(scene)  # build coal shapes outside the timing
-        distance.PARALLEL_MIN_BATCH = 10**12
-        t_d = best_time(lambda s=scene, q=q: gp.signed_distance(s, q), args.repeats)
-        t_g = best_time(lambda s=scene, q=q: gp.signed_distance_and_grad(s, q), args.repeats)
-        distance.PARALLEL_MIN_BATCH = 2000
-        t_p = best_time(lambda s=scene, q=q: gp.signed_distance_and_grad(s, q), args.repeats)
-        print(f"| {env} | {t_d:.3f} | {t_g:.3f} | {t_p:.3f} | {1e6 * t_p / args.n:.1f} |")
+
+        def on(cores_from: int, fn, s=scene, q=q):
+            def call():
+                distance.PARALLEL_MIN_BATCH = cores_from
+                fn(s, q)
+
+            return call
+
+        t = common.time_calls(
+            {
+                "d": on(10**12, gp.signed_distance),
+                "d+grad": on(10**12, gp.signed_distance_and_grad),
+                "d+grad, all cores": on(parallel, gp.signed_distance_and_grad),
+            },
+            repeats=args.repeats,
+        )
+        distance.PARALLEL_MIN_BATCH = parallel
+        best = [t[k].best for k in ("d", "d+grad", "d+grad, all cores")]
+        table.add(env, *(f"{s:.3f}" for s in best), f"{1e6 * best[2] / args.n:.1f}")
+    report.write()
 
 
 if __name__ == "__main__":

@@ -1,21 +1,21 @@
 """signed_ring_distance against its textbook form, side by side in one run.
 
-Usage: python benchmarks/ring_distance.py [--envs c d e] [--n 1000] [--chunk 100] [--repeats 5]
-
 Points: the robot graph's nodes at n random configurations of each scene (seed 3), each node
 repeated 5 times (as many points as nodes plus the probes of ``probe_split=5``); obstacles: the
 scene's rings. Both forms compute s (B, P) and ∂s/∂points by autograd, in chunks of ``chunk``
-configurations on one torch thread. The textbook form differentiates through all point-edge pairs
-((B, P, M, 2) tensors); :func:`gdnplan.models.graphdistnet.signed_ring_distance` finds the
-nearest edge and the winding number without autograd on separate x/y tensors and differentiates
-the nearest edge only. Prints the best time of each, their ratio and the largest differences.
+configurations (``--threads`` torch threads). The textbook form differentiates through all
+point-edge pairs ((B, P, M, 2) tensors);
+:func:`gdnplan.models.graphdistnet.signed_ring_distance` finds the nearest edge and the winding
+number without autograd on separate x/y tensors and differentiates the nearest edge only.
+Reports the best time of each (interleaved repeats after one warm-up), their ratio and the
+largest differences.
+
+    python benchmarks/ring_distance.py --threads 1 [--envs c d e] [--n 1000] [--chunk 100]
 """
 
 from __future__ import annotations
 
-import argparse
-import time
-
+import common
 import numpy as np
 import torch
 
@@ -58,33 +58,49 @@ def run(fn, points: torch.Tensor, graph, chunk: int) -> tuple[torch.Tensor, torc
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--envs", nargs="+", default=["c", "d", "e"])
-    parser.add_argument("--n", type=int, default=1000)
-    parser.add_argument("--chunk", type=int, default=100)
-    parser.add_argument("--repeats", type=int, default=5)
-    args = parser.parse_args()
-    torch.set_num_threads(1)
-    print(f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, n={args.n}, chunk={args.chunk}")
+    p = common.parser("ring_distance", __doc__)
+    p.add_argument("--envs", nargs="+", default=["c", "d", "e"])
+    p.add_argument("--n", type=int, default=1000)
+    p.add_argument("--chunk", type=int, default=100)
+    p.add_argument("--repeats", type=int, default=5)
+    args = common.parse(p)
+    report = common.Report(
+        args, "signed_ring_distance against its textbook form", common.first_paragraph(__doc__)
+    )
+    report.text(
+        f"n = {args.n} configurations, chunks of {args.chunk}, best of {args.repeats}; forward "
+        "+ ∂s/∂points."
+    )
+    table = report.table(
+        "env", "points × edges", "textbook (ms)", "gdnplan (ms)", "ratio", "max |Δs|, |Δ∂s|"
+    )
     for env in args.envs:
         scene = gp.make_scene(env, seed=3)
         graph = obstacle_graph(*scene_obstacles([scene]))
         nodes = robot_graph(scene.robot).positions(scene.robot.sample(args.n, seed=3))
         points = torch.tensor(np.repeat(nodes, 5, axis=1), dtype=torch.float32)
         forms = {"textbook": textbook, "gdnplan": signed_ring_distance}
-        best, out = dict.fromkeys(forms, np.inf), {}
-        for _ in range(args.repeats):
-            for name, fn in forms.items():
-                start = time.perf_counter()
+        out = {}
+
+        def call(name, fn, out=out, points=points, graph=graph):
+            def go():
                 out[name] = run(fn, points, graph, args.chunk)
-                best[name] = min(best[name], time.perf_counter() - start)
+
+            return go
+
+        t = common.time_calls({n: call(n, f) for n, f in forms.items()}, repeats=args.repeats)
         ds = (out["gdnplan"][0] - out["textbook"][0]).abs().max().item()
         dg = (out["gdnplan"][1] - out["textbook"][1]).abs().max().item()
-        print(
-            f"{env}: {points.shape[1]} points x {graph.nodes.shape[1]} edges, "
-            f"textbook {best['textbook'] * 1e3:.0f} ms, gdnplan {best['gdnplan'] * 1e3:.0f} ms, "
-            f"ratio {best['textbook'] / best['gdnplan']:.2f}x; max |Δs| {ds:.1e}, |Δ∂s| {dg:.1e}"
+        best = {name: timing.best for name, timing in t.items()}
+        table.add(
+            env,
+            f"{points.shape[1]} × {graph.nodes.shape[1]}",
+            f"{best['textbook'] * 1e3:.0f}",
+            f"{best['gdnplan'] * 1e3:.0f}",
+            f"{best['textbook'] / best['gdnplan']:.1f}×",
+            f"{ds:.0e}, {dg:.0e}",
         )
+    report.write()
 
 
 if __name__ == "__main__":

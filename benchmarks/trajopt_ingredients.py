@@ -6,29 +6,20 @@ infeasible: Problem rejects pairs whose first-link sweep collides), coal
 constraints, Ipopt, T = 20 waypoints, margin 0.02 m. Every variant's plan is judged by the
 certified coal check (conservative advancement, ≤ 1 mm motion between checks).
 
-    .venv/bin/python benchmarks/trajopt_ingredients.py [--n 20] [--seed 0]
-
-Prints a markdown table and writes it to results/trajopt_ingredients.md.
+    python benchmarks/trajopt_ingredients.py --threads 1 [--n 20] [--seed 0]
 """
 
 from __future__ import annotations
 
-import argparse
-import datetime
-import os
-import platform
-import subprocess
 import sys
 from dataclasses import dataclass
-from pathlib import Path
 
+import common
 import numpy as np
 
 import gdnplan as gp
-from gdnplan.files import check_output_path, write_text
 from gdnplan.trajopt import Plan, Problem, TrajoptOptions, plan, tip_position
 
-ROOT = Path(__file__).resolve().parent.parent
 VARIANTS = {
     "straight-line guess (prototype baseline)": TrajoptOptions(
         initial="straight", ccd=False, per_link=False
@@ -113,44 +104,28 @@ def table(rows: list[Row]) -> str:
     return "\n".join(lines)
 
 
-def machine() -> str:
-    sha = subprocess.run(
-        ["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True
-    ).stdout.strip()
-    return (
-        f"{platform.node()}, {platform.machine()}, {os.cpu_count()} CPUs "
-        f"({platform.processor() or 'unknown'}), Python {platform.python_version()}, "
-        f"git {sha}"
-    )
-
-
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--n", type=int, default=20)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", type=Path, default=ROOT / "results" / "trajopt_ingredients.md")
-    args = ap.parse_args()
-    check_output_path(args.out, (".md",), "--out")  # before the (long) run
-    host = machine()  # git sha of the code that runs, taken before the (long) run
+    p = common.parser("trajopt_ingredients", __doc__)
+    p.add_argument("--n", type=int, default=20)
+    p.add_argument("--seed", type=int, default=0)
+    args = common.parse(p)
+    report = common.Report(
+        args,
+        "Trajectory optimisation: what each ingredient adds (coal constraints, Ipopt)",
+        common.first_paragraph(__doc__),
+    )
     problems = make_problems(args.n, args.seed)
     rows = []
     for name, opts in VARIANTS.items():
         print(name, file=sys.stderr, flush=True)
         rows.append(Row(name, run(problems, opts)))
-    text = (
-        "# Trajectory optimisation: what each ingredient adds (coal constraints, Ipopt)\n\n"
-        f"{args.n} planar7 problems on environment (d), T = 20, margin 0.02 m, "
-        "success = certified coal check of the path (conservative advancement, ≤ 1 mm motion "
-        "between checks) + goal reached. Time = whole `plan` call (seed search, all Ipopt "
-        "attempts, verification).\n\n"
-        f"{table(rows)}\n\n"
-        f"- machine: {host}; load average at the end {os.getloadavg()[0]:.1f} (shared CPUs)\n"
-        f"- command: `.venv/bin/python benchmarks/trajopt_ingredients.py --n {args.n} "
-        f"--seed {args.seed}`\n"
-        f"- date: {datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC\n"
+    report.text(
+        f"{args.n} planar7 problems on environment (d), T = 20, margin 0.02 m, success = "
+        "certified coal check of the path (conservative advancement) + goal reached. Time = "
+        "whole `plan` call (seed search, all Ipopt attempts, verification)."
     )
-    print(text)
-    write_text(args.out, text, "--out")
+    report.text(table(rows))
+    report.write()
 
 
 if __name__ == "__main__":
