@@ -191,7 +191,7 @@ def convex_decomposition(poly: np.ndarray) -> list[np.ndarray]:
     Constrained Delaunay triangulation (shapely, O(n log n)), then Hertel–Mehlhorn: drop
     each diagonal whose removal keeps both its ends convex (O(1) per diagonal on a half-edge
     structure), at most 4× the fewest convex parts. A convex input is its only part.
-    2 000 vertices take well under a second.
+    (``MAX_VERTICES`` is sized by its cost: docs/decisions.md#vertex-limit.)
     """
     if is_convex(poly):
         return [poly]

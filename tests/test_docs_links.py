@@ -1,5 +1,6 @@
-"""Every relative link and image of README.md and docs/*.md points to a file of the repository
-(the site build, ``mkdocs build --strict``, checks the links inside docs/ only)."""
+"""Every relative link and image of README.md, docs/**/*.md and benchmarks/**/*.md points to a
+file of the repository (the site build, ``mkdocs build --strict``, checks the links inside docs/
+only)."""
 
 import re
 from pathlib import Path
@@ -7,7 +8,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+PAGES = [
+    ROOT / "README.md",
+    *sorted((ROOT / "docs").rglob("*.md")),
+    *sorted((ROOT / "benchmarks").rglob("*.md")),
+]
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 
 

@@ -49,8 +49,8 @@ class _LeakyRingMessages(torch.autograd.Function):
         pre[:, 2] = c
         acts = [nn.functional.leaky_relu_(pre, LEAKY_SLOPE)]
         for w, bias in zip(weights[::2], weights[1::2], strict=True):
-            # a product then an in-place bias: faster than linear's addmm, which first copies the
-            # broadcast bias into its (B·3·N, H) output
+            # a product then an in-place bias: linear's addmm first copies the broadcast bias
+            # into its (B·3·N, H) output (docs/decisions.md#lean-path)
             acts.append(nn.functional.leaky_relu_((acts[-1] @ w.T).add_(bias), LEAKY_SLOPE))
         ctx.save_for_backward(ring, *weights[::2], *acts)
         return acts[-1].sum(1)

@@ -17,8 +17,9 @@ from .layers import _LeakyRingMessages
 def _softmax_small(logits: torch.Tensor) -> torch.Tensor:
     """Softmax over a short last dimension (the C candidates): exp(l − max l) / Σ exp(l − max l).
 
-    The same function as :func:`torch.softmax`, several times faster than it for C ≈ 5 on CPU;
-    the shift max l is a constant to autograd (the softmax does not depend on it).
+    The same function as :func:`torch.softmax`, written out because so few candidates make the
+    library call's overhead dominate on CPU (docs/decisions.md#lean-path); the shift max l is a
+    constant to autograd (the softmax does not depend on it).
     """
     e = (logits - logits.detach().amax(-1, keepdim=True)).exp()
     return e / e.sum(-1, keepdim=True)
@@ -28,7 +29,7 @@ def _cross_mix(idx: torch.Tensor, w: torch.Tensor, n_r: int) -> tuple[torch.Tens
     """Dense cross weights: M_ro (B, N_r, N_o) and M_or (B, N_o, N_r), (M)_ij = Σ_{c: j_c = j} w_ic.
 
     Σ_c w_ic v_{j_c} is then row i of M_ro v_o (robot nodes i) or M_or v_r (obstacle nodes):
-    a batched matrix product instead of a (B, N, C, d_h) gather (faster on CPU).
+    a batched matrix product instead of a (B, N, C, d_h) gather (docs/decisions.md#lean-path).
 
     Args:
         idx: (B, N, C) union indices of the candidates (robot nodes first); w: (B, N, C).

@@ -19,8 +19,8 @@ from ..threads import check_threads, torch_threads
 from .lean import SceneGraph
 from .network import GraphDistNet
 
-# graph nodes per inference pass: (d) two-way 80 configurations × 108 nodes, one-way 320 × 28
-# were the fastest chunks on the 2-core Xeon (benchmarks/RESULTS.md)
+# graph nodes per inference pass: the per-pass fixed cost favours large chunks, memory small
+# ones (docs/decisions.md#chunk-nodes)
 CHUNK_NODES = 9000
 
 
