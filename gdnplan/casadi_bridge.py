@@ -11,8 +11,8 @@ and one batched ``distance_and_grad`` call yields both the values and the Jacobi
 (x, y, ∂y/∂x) is cached: Ipopt asks for the value and the Jacobian at the same point, which then
 costs one model pass. A model with ``distance_deferred_grad`` (GraphDistNet) computes the
 Jacobian only when Ipopt asks for it: the line search's rejected trial points then cost a
-forward pass alone (docs/decisions.md#deferred-gradients). Build the NLP with MX symbols (SX would call the callback per
-nonzero).
+forward pass alone (docs/decisions.md#deferred-gradients). Build the NLP with MX symbols (SX
+would call the callback per nonzero).
 """
 
 from __future__ import annotations

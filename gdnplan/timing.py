@@ -356,7 +356,8 @@ def time_path(
     a = limit_vector(max_acceleration, q.shape[1], "max_acceleration", "rad/s²")
     knots, index = _chord_knots(q)
     if scene is not None and len(knots) > 1:
-        from scipy.interpolate import PchipInterpolator  # here: slow import (decisions.md#lazy-imports)
+        # imported here: a slow import (docs/decisions.md#lazy-imports)
+        from scipy.interpolate import PchipInterpolator
 
         curve = PchipInterpolator(knots, q[np.unique(index, return_index=True)[1]], axis=0)
         cert = certify_curve(scene, curve)
