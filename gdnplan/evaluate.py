@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -131,11 +132,12 @@ class BatchedGraphDistNet:
         from .train import predict as predict_net
         from .train import tensors
 
-        return predict_net(self.model.net, tensors(ds, self.model.net.config), grad=grad)
+        return predict_net(self.model.net, tensors(ds), grad=grad)
 
 
-def load_graphdistnet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
-    """GraphDistNet from ``<weights_dir>/<env>.safetensors`` when it exists, else None."""
+def graphdistnet_of_env(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
+    """Environment ``env``'s GraphDistNet for Table I, from ``<weights_dir>/<env>.safetensors``
+    (batched over datasets), or None when that file is missing."""
     path = Path(weights_dir) / f"{env}.safetensors"
     if not path.exists():
         return None
@@ -144,12 +146,32 @@ def load_graphdistnet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceMode
     return BatchedGraphDistNet(load_model(path))
 
 
-def load_clearancenet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
-    """ClearanceNet from ``<weights_dir>/clearancenet_<env>.safetensors``, None if missing."""
+def clearancenet_of_env(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
+    """Environment ``env``'s ClearanceNet for Table I, from
+    ``<weights_dir>/clearancenet_<env>.safetensors``, or None when that file is missing."""
     from .models.clearancenet import load as load_cn
 
     path = Path(weights_dir) / f"clearancenet_{env}.safetensors"
     return load_cn(path) if path.exists() else None
+
+
+def _deprecated(old: str, new):
+    def alias(*args, **kwargs):
+        warnings.warn(
+            f"gdnplan.evaluate.{old} is deprecated; use gdnplan.evaluate.{new.__name__} (by "
+            "environment name) or gdnplan.load_model (a weights file or shipped name)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return new(*args, **kwargs)
+
+    alias.__name__ = old
+    alias.__doc__ = f"Deprecated name of :func:`{new.__name__}`."
+    return alias
+
+
+load_graphdistnet = _deprecated("load_graphdistnet", graphdistnet_of_env)
+load_clearancenet = _deprecated("load_clearancenet", clearancenet_of_env)
 
 
 def diffco_rows(env: str, ds: Dataset, s: TableSettings) -> list[Result]:
@@ -229,7 +251,10 @@ def table1_env(
         "ClearanceNet": f"clearancenet_{env}.safetensors",
         "GraphDistNet": f"{env}.safetensors",
     }
-    for name, loader in (("ClearanceNet", load_clearancenet), ("GraphDistNet", load_graphdistnet)):
+    for name, loader in (
+        ("ClearanceNet", clearancenet_of_env),
+        ("GraphDistNet", graphdistnet_of_env),
+    ):
         if used is not None and (Path(weights_dir) / files[name]).exists():
             used[files[name]] = sha256_prefix(Path(weights_dir) / files[name])
         model = loader(env, weights_dir)
@@ -388,7 +413,7 @@ def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000, progress: bo
     t0 = time.perf_counter()
     models["DiffCo score −s"] = DiffCo.train(scene, n=diffco_train)
     log.info("field: DiffCo trained on %d samples, %.2f s", diffco_train, time.perf_counter() - t0)
-    gdn = load_graphdistnet(env)
+    gdn = graphdistnet_of_env(env)
     if gdn is not None:
         models["GraphDistNet d̂ (m)"] = gdn
     total = len(models) * grid * grid
