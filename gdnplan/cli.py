@@ -627,17 +627,9 @@ def train_command(
     from .data import DATA_DIR
     from .train import FitConfig
 
-    if model not in ("graphdistnet", "clearancenet"):
-        raise InputError(f"--model: expected graphdistnet or clearancenet, got {model!r}")
-    if model == "clearancenet":
-        values = (preset, name, set_, run_dir, compile, init, extra)
-        given = [flag for flag, value in zip(GRAPHDISTNET_ONLY, values, strict=True) if value]
-        if given:
-            raise InputError(
-                f"{given[0]}: does not apply to --model clearancenet (GraphDistNet only); "
-                f"drop {', '.join(given)}"
-            )
-        time_budget = CLEARANCENET_BUDGET if time_budget is None else time_budget
+    _check_model(model, (preset, name, set_, run_dir, compile, init, extra))
+    if model == "clearancenet" and time_budget is None:
+        time_budget = CLEARANCENET_BUDGET
     schedule = FitConfig(batch, lr, epochs, patience, time_budget, seed, device)
     init = None if init is None else weights_file(init)
     if out is not None:
@@ -659,6 +651,20 @@ def train_command(
         run_dir=run_dir,
     )  # fmt: skip
     typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
+
+
+def _check_model(model: str, graphdistnet_only: tuple) -> None:
+    """InputError naming the model, or the first GraphDistNet option given to ClearanceNet."""
+    if model not in ("graphdistnet", "clearancenet"):
+        raise InputError(f"--model: expected graphdistnet or clearancenet, got {model!r}")
+    if model == "clearancenet":
+        pairs = zip(GRAPHDISTNET_ONLY, graphdistnet_only, strict=True)
+        given = [flag for flag, value in pairs if value]
+        if given:
+            raise InputError(
+                f"{given[0]}: does not apply to --model clearancenet (GraphDistNet only); "
+                f"drop {', '.join(given)}"
+            )
 
 
 def _train_clearancenet(env: str, schedule, out: Path | None, n_train: int | None, root: Path):

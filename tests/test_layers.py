@@ -42,7 +42,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("casadi bridge", ("casadi_bridge",)),
     ("trajopt", ("trajopt", "trajopt.*", "timing")),
     ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
-    ("paper reproduction", ("evaluate", "table2", "fetch", "viz", "viz3d")),
+    ("paper reproduction", ("env_models", "evaluate", "table2", "fetch", "viz", "viz3d")),
     ("cli", ("cli", "__init__")),
 ]
 
