@@ -368,7 +368,7 @@ def evaluate_command(
 
         chosen = DiffCo.train(make_scene(ev.DIFFCO_SOURCE.get(env, env)), n=3000)
     else:
-        loader = ev.load_clearancenet if model == "clearancenet" else ev.load_graphdistnet
+        loader = ev.clearancenet_of_env if model == "clearancenet" else ev.graphdistnet_of_env
         chosen = loader(env)
         if chosen is None:
             raise InputError(f"--model: no {model} weights for env {env} in weights/")
@@ -567,13 +567,23 @@ def generate_command(
     typer.echo(f"wrote {target}")
 
 
+GRAPHDISTNET_ONLY = ("--preset", "--name", "--set", "--run-dir", "--compile", "--init", "--extra")
+CLEARANCENET_BUDGET = 120.0  # s: --time-budget of --model clearancenet when none is given
+
+
 @app.command("train")
 def train_command(
     env: str = typer.Option(..., help="Environment: a-e or ur5e (its data must exist)."),
     model: str = typer.Option("graphdistnet", help="graphdistnet or clearancenet."),
-    preset: str = typer.Option("smooth", help="GraphDistNet: smooth (planner) or faithful."),
-    name: str = typer.Option(None, help="Run name, runs/<env>-<name> (default: the preset)."),
-    set_: list[str] = typer.Option([], "--set", help="Config override key=json_value."),
+    preset: str = typer.Option(
+        None, help="GraphDistNet: smooth (planner, the default) or faithful."
+    ),
+    name: str = typer.Option(
+        None, help="GraphDistNet run name, runs/<env>-<name> (default: the preset)."
+    ),
+    set_: list[str] = typer.Option(
+        [], "--set", help="GraphDistNet architecture or loss override key=json_value."
+    ),
     n_train: int = typer.Option(
         None, min=2, help="Use only the first n training samples (≥ 2: 10 % validate)."
     ),
@@ -581,28 +591,46 @@ def train_command(
     lr: float = typer.Option(1e-3, help="Adam learning rate (≥ 0; 0 keeps --init's weights)."),
     epochs: int = typer.Option(200, min=1, help="Epoch cap."),
     patience: int = typer.Option(10, min=1, help="Early stopping: epochs without improvement."),
-    time_budget: float = typer.Option(None, help="Seconds of training (> 0)."),
+    time_budget: float = typer.Option(
+        None, help="Seconds of training (> 0; default none, clearancenet 120)."
+    ),
     seed: int = typer.Option(0, min=0, help="Random seed."),
     device: str = typer.Option("cpu", help="cpu or cuda."),
     threads: int = typer.Option(1, help="torch threads."),
     data: Path = typer.Option(None, help="Data root (default: data/)."),
-    out: Path = typer.Option(None, help="Weights path (default: weights/<env>.safetensors)."),
-    run_dir: Path = typer.Option(None, help="Checkpoints, loss curve (default runs/<env>-<name>)."),
-    compile: bool = typer.Option(False, "--compile", help="torch.compile the training step."),
+    out: Path = typer.Option(
+        None, help="Weights path (default: weights/<env>.safetensors, clearancenet_<env>)."
+    ),
+    run_dir: Path = typer.Option(
+        None, help="GraphDistNet checkpoints, loss curve (default runs/<env>-<name>)."
+    ),
+    compile: bool = typer.Option(
+        False, "--compile", help="GraphDistNet: torch.compile the training step."
+    ),
     init: str = typer.Option(
         None,
         help="Fine-tune from these GraphDistNet weights, a shipped name or a path (their "
         "card's config; --set applies).",
     ),
     extra: list[Path] = typer.Option(
-        [], help="More training shards (a directory, e.g. from generate --near); repeatable."
+        [],
+        help="More GraphDistNet training shards (a directory, e.g. from generate --near); "
+        "repeatable.",
     ),
 ) -> None:
-    """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card."""
-    from .assets import weights_file
-    from .train import check_options
+    """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card.
 
-    check_options(n_train, batch, lr, epochs, patience, time_budget, device)
+    Every option applies to GraphDistNet; the ones marked GraphDistNet (and --init, --extra)
+    are refused with --model clearancenet instead of being ignored.
+    """
+    from .assets import weights_file
+    from .data import DATA_DIR
+    from .train import FitConfig
+
+    _check_model(model, (preset, name, set_, run_dir, compile, init, extra))
+    if model == "clearancenet" and time_budget is None:
+        time_budget = CLEARANCENET_BUDGET
+    schedule = FitConfig(batch, lr, epochs, patience, time_budget, seed, device)
     init = None if init is None else weights_file(init)
     if out is not None:
         check_output_path(out, (".safetensors",), "--out")
@@ -610,62 +638,74 @@ def train_command(
     if run_dir is not None:
         check_output_dir(run_dir, "--run-dir")
     if model == "clearancenet":
-        from .train_clearancenet import train_and_save
-
-        card = train_and_save(env, time_budget or 120.0, patience, out)
+        set_threads(threads, torch_global=True)
+        card = _train_clearancenet(env, schedule, out, n_train, data or DATA_DIR)
         typer.echo(json.dumps({"env": env, **card["test"]}, indent=2))
         return
-    if model != "graphdistnet":
+    config = _graphdistnet_run(preset, set_, init, schedule, n_train, extra, compile)
+    set_threads(threads, torch_global=True)
+    from . import train as training
+
+    card = training.train(
+        env, config, name or preset or "smooth", data_root=data or DATA_DIR, out=out,
+        run_dir=run_dir,
+    )  # fmt: skip
+    typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
+
+
+def _check_model(model: str, graphdistnet_only: tuple) -> None:
+    """InputError naming the model, or the first GraphDistNet option given to ClearanceNet."""
+    if model not in ("graphdistnet", "clearancenet"):
         raise InputError(f"--model: expected graphdistnet or clearancenet, got {model!r}")
+    if model == "clearancenet":
+        pairs = zip(GRAPHDISTNET_ONLY, graphdistnet_only, strict=True)
+        given = [flag for flag, value in pairs if value]
+        if given:
+            raise InputError(
+                f"{given[0]}: does not apply to --model clearancenet (GraphDistNet only); "
+                f"drop {', '.join(given)}"
+            )
 
-    from .data import DATA_DIR
-    from .models.graphdistnet import GraphDistNetConfig
-    from .train import PRESETS, train
 
-    if preset not in PRESETS:
+def _train_clearancenet(env: str, schedule, out: Path | None, n_train: int | None, root: Path):
+    """``gdnplan train --model clearancenet``: the card of the weights written."""
+    from .train import train_and_score
+
+    command = (
+        f"gdnplan train --model clearancenet --env {env} --time-budget {schedule.time_budget:g} "
+        f"--patience {schedule.patience} --epochs {schedule.epochs} --batch {schedule.batch} "
+        f"--lr {schedule.lr:g} --seed {schedule.seed}"
+        + (f" --n-train {n_train}" if n_train is not None else "")
+    )
+    return train_and_score(env, schedule, out, n_train, root, command)
+
+
+def _graphdistnet_run(preset, set_, init, schedule, n_train, extra, compile):
+    """The TrainConfig of ``gdnplan train`` (GraphDistNet) from its options."""
+    from .train import PRESETS, TrainConfig, card_settings, split_config
+
+    if preset is not None and preset not in PRESETS:
         raise InputError(f"--preset: expected one of {sorted(PRESETS)}, got {preset!r}")
+    if preset is not None and init is not None:
+        raise InputError(
+            "--preset: does not apply with --init (the network is the --init weights' card's; "
+            "change it with --set)"
+        )
     try:
         overrides = {k: json.loads(v) for k, v in (s.split("=", 1) for s in set_)}
     except ValueError as e:
         raise InputError(f"--set: expected key=json_value, got {set_}") from e
-    base = PRESETS[preset]().to_dict() if init is None else _card_config(init)
+    if init is None:
+        base = PRESETS[preset or "smooth"]().to_dict()
+    else:
+        base = card_settings(init)
     try:
-        config = GraphDistNetConfig.from_dict(base | overrides)
+        network, loss = split_config(base | overrides)
     except (TypeError, ValueError) as e:
         if isinstance(e, InputError):
             raise InputError(f"--set: {e}") from e
         raise InputError(f"--set: a value of the wrong type in {set_} ({e})") from e
-    set_threads(threads, torch_global=True)
-    card = train(
-        env,
-        config,
-        name or preset,
-        n_train,
-        batch,
-        lr,
-        epochs,
-        patience,
-        time_budget,
-        seed,
-        device,
-        data_root=data or DATA_DIR,
-        out=out,
-        run_dir=run_dir,
-        compile=compile,
-        init=init,
-        extra=extra,
-    )
-    typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
-
-
-def _card_config(weights: Path) -> dict:
-    """The config of the JSON card beside ``weights`` (InputError when it is missing)."""
-    from .models.weights import read_card
-
-    config = read_card(weights, "--init").get("config")
-    if not isinstance(config, dict):
-        raise InputError(f"--init: the card of {weights} has no 'config' object")
-    return config
+    return TrainConfig(network, loss, schedule, n_train, tuple(extra), init, compile)
 
 
 FIELD_GRID_MAX = 1001  # 10⁶ configurations, minutes per model

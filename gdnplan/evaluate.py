@@ -18,6 +18,10 @@ import numpy as np
 from .assets import WEIGHTS_DIR
 from .data import Dataset
 from .distance import signed_distance_and_grad
+from .env_models import BatchedGraphDistNet as BatchedGraphDistNet
+from .env_models import clearancenet_of_env, graphdistnet_of_env
+from .env_models import load_clearancenet as load_clearancenet  # deprecated names
+from .env_models import load_graphdistnet as load_graphdistnet
 from .metrics import (  # moved to gdnplan.metrics; the `x as x` names are re-exported
     DEFAULT_MARGIN,
     Result,
@@ -37,7 +41,6 @@ from .metrics import mean_absolute_error as mean_absolute_error
 from .metrics import roc_auc as roc_auc
 from .metrics import scene_groups as scene_groups
 from .metrics import used_cosine_distances as used_cosine_distances
-from .models import DistanceModel
 
 log = logging.getLogger(__name__)
 
@@ -109,47 +112,6 @@ class TableSettings:
         return cls(
             n=200, n_grad=100, diffco_train=(400, 600), al_scenes=1, al_queries=100, al_explore=300
         )
-
-
-class BatchedGraphDistNet:
-    """GraphDistNet with :meth:`predict_dataset`: one batched pass over samples with their own
-    obstacle graphs (graph construction included), via :mod:`gdnplan.train`'s tensors."""
-
-    name = "GraphDistNet"
-    is_distance = True
-
-    def __init__(self, model):
-        self.model = model
-
-    def distance(self, scene, q: np.ndarray) -> np.ndarray:
-        return self.model.distance(scene, q)
-
-    def distance_and_grad(self, scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return self.model.distance_and_grad(scene, q)
-
-    def predict_dataset(self, ds: Dataset, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
-        from .train import predict as predict_net
-        from .train import tensors
-
-        return predict_net(self.model.net, tensors(ds, self.model.net.config), grad=grad)
-
-
-def load_graphdistnet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
-    """GraphDistNet from ``<weights_dir>/<env>.safetensors`` when it exists, else None."""
-    path = Path(weights_dir) / f"{env}.safetensors"
-    if not path.exists():
-        return None
-    from .models import load_model
-
-    return BatchedGraphDistNet(load_model(path))
-
-
-def load_clearancenet(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:
-    """ClearanceNet from ``<weights_dir>/clearancenet_<env>.safetensors``, None if missing."""
-    from .models.clearancenet import load as load_cn
-
-    path = Path(weights_dir) / f"clearancenet_{env}.safetensors"
-    return load_cn(path) if path.exists() else None
 
 
 def diffco_rows(env: str, ds: Dataset, s: TableSettings) -> list[Result]:
@@ -229,7 +191,10 @@ def table1_env(
         "ClearanceNet": f"clearancenet_{env}.safetensors",
         "GraphDistNet": f"{env}.safetensors",
     }
-    for name, loader in (("ClearanceNet", load_clearancenet), ("GraphDistNet", load_graphdistnet)):
+    for name, loader in (
+        ("ClearanceNet", clearancenet_of_env),
+        ("GraphDistNet", graphdistnet_of_env),
+    ):
         if used is not None and (Path(weights_dir) / files[name]).exists():
             used[files[name]] = sha256_prefix(Path(weights_dir) / files[name])
         model = loader(env, weights_dir)
@@ -388,7 +353,7 @@ def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000, progress: bo
     t0 = time.perf_counter()
     models["DiffCo score −s"] = DiffCo.train(scene, n=diffco_train)
     log.info("field: DiffCo trained on %d samples, %.2f s", diffco_train, time.perf_counter() - t0)
-    gdn = load_graphdistnet(env)
+    gdn = graphdistnet_of_env(env)
     if gdn is not None:
         models["GraphDistNet d̂ (m)"] = gdn
     total = len(models) * grid * grid

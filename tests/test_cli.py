@@ -1,6 +1,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -285,3 +286,94 @@ def test_input_errors_stay_exit_2_and_usage_errors_are_one_line():
     proc = _cli("", "--debug", "show", "zz")
     assert proc.returncode == 2 and "Traceback" in proc.stderr
     assert proc.stderr.splitlines()[-1].startswith("error: scene: unknown name")
+
+
+# ---------------------------------------------------------------- train: every flag × model
+# flag -> (arguments, the value the run must receive: f(kind, captured call) -> value, expected)
+TRAIN_FLAGS = {
+    "--n-train": (["--n-train", "50"], lambda k, c: c["n_train"], 50),
+    "--batch": (["--batch", "8"], lambda k, c: c["fit"].batch, 8),
+    "--lr": (["--lr", "0.01"], lambda k, c: c["fit"].lr, 0.01),
+    "--epochs": (["--epochs", "3"], lambda k, c: c["fit"].epochs, 3),
+    "--patience": (["--patience", "2"], lambda k, c: c["fit"].patience, 2),
+    "--time-budget": (["--time-budget", "5"], lambda k, c: c["fit"].time_budget, 5.0),
+    "--seed": (["--seed", "4"], lambda k, c: c["fit"].seed, 4),
+    "--device": (["--device", "cpu"], lambda k, c: c["fit"].device, "cpu"),
+    "--threads": (["--threads", "2"], lambda k, c: c["threads"], 2),
+    "--data": (["--data", "elsewhere"], lambda k, c: str(c["root"]), "elsewhere"),
+    "--out": (["--out", "{tmp}/w.safetensors"], lambda k, c: c["out"].name, "w.safetensors"),
+    "--preset": (["--preset", "faithful"], lambda k, c: c["config"].network.cross, "argmax"),
+    "--name": (["--name", "run7"], lambda k, c: c["name"], "run7"),
+    "--set": (["--set", "layers=2"], lambda k, c: c["config"].network.layers, 2),
+    "--run-dir": (["--run-dir", "{tmp}/r"], lambda k, c: c["run_dir"].name, "r"),
+    "--compile": (["--compile"], lambda k, c: c["config"].compile, True),
+    "--init": (["--init", "b"], lambda k, c: c["config"].init.name, "b.safetensors"),
+    "--extra": (["--extra", "more"], lambda k, c: c["config"].extra, (Path("more"),)),
+}
+GRAPHDISTNET_ONLY = {"--preset", "--name", "--set", "--run-dir", "--compile", "--init", "--extra"}
+
+
+@pytest.fixture
+def captured_training(monkeypatch):
+    """Replace both trainers by recorders of what the command gives them (nothing trains)."""
+    import torch
+
+    import gdnplan.train
+
+    calls: dict = {}
+    threads = torch.get_num_threads()
+
+    def graphdistnet(env, config, name, data_root, out, run_dir):
+        calls.update(kind="graphdistnet", config=config, fit=config.fit, name=name,
+                     n_train=config.n_train, root=data_root, out=out, run_dir=run_dir,
+                     threads=torch.get_num_threads())  # fmt: skip
+        return {"name": name, "test": {}}
+
+    def clearancenet(env, fit, out, n_train, root, command):
+        calls.update(kind="clearancenet", fit=fit, out=out, n_train=n_train, root=root,
+                     threads=torch.get_num_threads())  # fmt: skip
+        return {"test": {}}
+
+    monkeypatch.setattr(gdnplan.train, "train", graphdistnet)
+    monkeypatch.setattr(gdnplan.train, "train_and_score", clearancenet)
+    yield calls
+    torch.set_num_threads(threads)
+
+
+@pytest.mark.parametrize("model", ["graphdistnet", "clearancenet"])
+@pytest.mark.parametrize("flag", sorted(TRAIN_FLAGS))
+def test_every_train_flag_applies_to_the_model_or_is_refused(
+    flag, model, captured_training, tmp_path, capsys
+):
+    """No option is ignored: it reaches the run of every model it applies to, and with a model
+    it does not apply to the command fails with one line naming the option and the model."""
+    from gdnplan.cli import run
+
+    args, received, expected = TRAIN_FLAGS[flag]
+    args = [a.replace("{tmp}", str(tmp_path)) for a in args]
+    with pytest.raises(SystemExit) as exit_:
+        run(["train", "--env", "a", "--model", model, *args])
+    err = capsys.readouterr().err
+    if model == "clearancenet" and flag in GRAPHDISTNET_ONLY:
+        assert exit_.value.code == 2 and err.count("\n") == 1, err
+        assert err.startswith(f"error: {flag}: does not apply to --model clearancenet"), err
+        assert not captured_training
+        return
+    assert exit_.value.code == 0, err
+    assert captured_training["kind"] == model
+    assert received(model, captured_training) == expected
+
+
+def test_clearancenet_keeps_its_default_budget_and_preset_with_init_is_refused(
+    captured_training, capsys
+):
+    from gdnplan.cli import run
+
+    with pytest.raises(SystemExit):
+        run(["train", "--env", "a", "--model", "clearancenet"])
+    assert captured_training["fit"].time_budget == 120.0
+    with pytest.raises(SystemExit) as exit_:
+        run(["train", "--env", "a", "--preset", "smooth", "--init", "a"])
+    assert (
+        exit_.value.code == 2 and "--preset: does not apply with --init" in capsys.readouterr().err
+    )

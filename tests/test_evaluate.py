@@ -110,3 +110,23 @@ def test_roc_and_scatter_figures(tmp_path):
     ]
     paths = ev.table1_figures({"a": (rows, None)}, tmp_path)
     assert all(p.stat().st_size > 1000 for p in paths)
+
+
+def test_one_name_per_loader_and_the_old_names_warn():
+    """By environment name (Table I) vs by file: distinct names; the old shared name of both
+    still works, with a DeprecationWarning naming the new one."""
+    from gdnplan.assets import weights_file
+    from gdnplan.models.graphdistnet import load_graphdistnet, load_graphdistnet_weights
+
+    scene = gp.make_scene("a", seed=0)
+    q = scene.robot.sample(4, seed=0)
+    by_env = ev.graphdistnet_of_env("a")
+    by_file = load_graphdistnet_weights(weights_file("a"))
+    np.testing.assert_array_equal(by_env.distance(scene, q), by_file.distance(scene, q))
+    assert ev.graphdistnet_of_env("zz") is None and ev.clearancenet_of_env("zz") is None
+    with pytest.warns(DeprecationWarning, match="graphdistnet_of_env"):
+        assert ev.load_graphdistnet("a") is not None
+    with pytest.warns(DeprecationWarning, match="clearancenet_of_env"):
+        assert ev.load_clearancenet("a") is not None
+    with pytest.warns(DeprecationWarning, match="load_graphdistnet_weights"):
+        load_graphdistnet(weights_file("a"))

@@ -20,7 +20,7 @@ from gdnplan.models.graphdistnet import (
     nearest_obstacle_nodes,
     signed_ring_distance,
 )
-from gdnplan.train import distance_loss, evaluate, gradient_loss
+from gdnplan.train import GraphDistNetLoss, distance_loss, evaluate, gradient_loss
 
 ROOT = Path(__file__).resolve().parent.parent
 WEIGHTS = ROOT / "weights"
@@ -52,7 +52,7 @@ def random_model(
     "changes",
     [
         {},
-        {"activation": "silu", "max_edge": 0.25},
+        {"cross_k": 2},
         {"two_way": False},
         {"node_distance": True},
         {"node_distance": True, "two_way": False, "min_readout": True},
@@ -185,8 +185,8 @@ def reference_distance_and_grad(
     model: GraphDistNetModel, scene: gp.Scene, q: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """d̂ and ∂d̂/∂q by the padded :meth:`GraphDistNet.forward` and the node Jacobians."""
-    graph = robot_graph(scene.robot, model.config.max_edge)
-    obstacles = obstacle_graph(*scene_obstacles([scene]), model.config.max_edge, dtype=model.dtype)
+    graph = robot_graph(scene.robot)
+    obstacles = obstacle_graph(*scene_obstacles([scene]), None, dtype=model.dtype)
     nodes, jac = graph.positions_and_jacobians(q)
     x = torch.tensor(nodes, dtype=model.dtype, requires_grad=True)
     d = model.net(graph.batch(x, dtype=model.dtype), _repeat(obstacles, len(q)))
@@ -198,15 +198,15 @@ LEAN_CASES = [  # (env, weights or config changes): small obstacle graphs pad th
     ("a", "a"),
     ("e", "e"),
     ("fetch", "ur5e"),
-    ("b", {"activation": "silu", "max_edge": 0.2}),
+    ("b", {"cross_k": 2}),
     ("d", {"mlp": ()}),
     ("d", {"two_way": False}),  # obstacle features cached per scene
-    ("a", {"two_way": False, "activation": "silu"}),  # fewer obstacle nodes than candidates
+    ("a", {"two_way": False}),  # fewer obstacle nodes than candidates
     ("c", {"node_distance": True}),
     ("d", {"node_distance": True, "two_way": False}),
     ("e", {"node_distance": True, "two_way": False, "min_readout": True}),
     ("b", {"node_distance": True, "min_readout": True}),
-    ("a", {"node_distance": True, "min_readout": True, "correction_band": 0.05, "max_edge": 0.1}),
+    ("a", {"node_distance": True, "min_readout": True, "correction_band": 0.05, "tau_min": 0.01}),
     ("a", {"node_distance": True, "min_readout": True, "correction_band": 0.05, "probe_split": 4}),
     ("d", {"node_distance": True, "min_readout": True, "two_way": False, "probe_split": 3}),
 ]
@@ -282,25 +282,6 @@ def test_shipped_weights_on_committed_test_split(env):
     assert m["mae_m"] <= max_mae and m["auc"] >= min_auc and m["acd"] <= max_acd, m
 
 
-def test_contact_weighted_distance_loss_by_hand():
-    d = torch.tensor([0.0, 1.0])  # a contact sample and one 1 m away
-    d_hat = torch.tensor([0.2, 1.4])  # squared errors 0.04 and 0.16 (scale 1)
-    plain = GraphDistNetConfig(scale=1.0)
-    assert float(distance_loss(d_hat, d, plain)) == pytest.approx(0.10)
-    weighted = plain.with_(contact_weight=3.0, contact_scale=0.02)  # w = 4 and 1 + 3e^-50 ≈ 1
-    assert float(distance_loss(d_hat, d, weighted)) == pytest.approx((4 * 0.04 + 0.16) / 5)
-
-
-def test_gradient_loss_with_slope_term_by_hand():
-    g = torch.tensor([[3.0, 4.0], [1.0, 0.0], [0.0, 0.0]])  # |g| = 5, 1; a zero label left out
-    g_hat = torch.tensor([[6.0, 8.0], [0.0, 2.0], [1.0, 1.0]])  # cos 1 (|ĝ| 10), cos 0 (|ĝ| 2)
-    cosine = GraphDistNetConfig(scale=2.0, grad_weight=0.5)
-    assert float(gradient_loss(g_hat, g, cosine)) == pytest.approx(0.5 * (0 + 1) / 2)
-    slope = cosine.with_(grad_norm_weight=0.1)  # ((10 − 5) / 2)² = 6.25, ((2 − 1) / 2)² = 0.25
-    expected = (0.5 * (0 + 1) + 0.1 * (6.25 + 0.25)) / 2
-    assert float(gradient_loss(g_hat, g, slope)) == pytest.approx(expected)
-
-
 def test_bad_inputs_raise_input_error():
     scene, model = random_model("a")
     with pytest.raises(gp.InputError):
@@ -311,12 +292,6 @@ def test_bad_inputs_raise_input_error():
         model.distance(scene.with_obstacles([]), np.zeros(2))
     with pytest.raises(gp.InputError):
         GraphDistNetConfig(cross="nearest")
-    with pytest.raises(gp.InputError):
-        GraphDistNetConfig(activation="relu")
-    with pytest.raises(gp.InputError):
-        GraphDistNetConfig(contact_weight=-1.0)
-    with pytest.raises(gp.InputError, match="grad_norm_weight"):
-        GraphDistNetConfig(grad_norm_weight=1.0)  # without the gradient loss
     with pytest.raises(gp.InputError, match="min_readout needs node_distance"):
         GraphDistNetConfig(min_readout=True)
     with pytest.raises(gp.InputError, match="tau_min"):
@@ -440,15 +415,26 @@ def test_training_step_with_gradient_loss_has_finite_gradients(readout):
     from gdnplan.train import forward_with_grad, tensors
 
     ds = load(TEST_DATA / "a_test.npz")
-    config = GraphDistNetConfig.smooth(
-        scale=1.2, node_distance=True, grad_weight=0.1, grad_norm_weight=0.1, **readout
-    )
+    config = GraphDistNetConfig.smooth(scale=1.2, node_distance=True, **readout)
+    weights = GraphDistNetLoss(grad_weight=0.1, grad_norm_weight=0.1)
     torch.manual_seed(0)
     net = GraphDistNet(config)
-    t = tensors(ds, config)
+    t = tensors(ds)
     rows = torch.arange(64)
     robot, obstacles = t.batch(rows, "cpu")
     d, g = forward_with_grad(net, robot, obstacles, t.jac[rows], True)
-    loss = distance_loss(d, t.d[rows], config) + gradient_loss(g, t.grad[rows], config)
+    loss = distance_loss(d, t.d[rows], weights, 1.2) + gradient_loss(g, t.grad[rows], weights, 1.2)
     loss.backward()
     assert all(torch.isfinite(p.grad).all() for p in net.parameters() if p.grad is not None)
+
+
+def test_config_keeps_the_architecture_and_refuses_removed_options_at_other_values():
+    """Old flat cards: loss weights skipped, removed options at their default dropped; a
+    removed option at another value, or a loss weight given to the architecture, is refused."""
+    old = {"layers": 2, "activation": "leaky_relu", "max_edge": None, "grad_weight": 0.1}
+    assert GraphDistNetConfig.from_dict(old) == GraphDistNetConfig(layers=2)
+    for key, value in (("activation", "silu"), ("max_edge", 0.25)):
+        with pytest.raises(gp.InputError, match=rf"^config: {key} = .*was removed"):
+            GraphDistNetConfig.from_dict({key: value})
+    with pytest.raises(gp.InputError, match="GraphDistNetLoss"):
+        GraphDistNetConfig().with_(grad_weight=0.1)

@@ -41,8 +41,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
     ("trajopt", ("trajopt", "trajopt.*", "timing")),
-    ("training", ("data", "metrics", "train", "train_clearancenet")),
-    ("paper reproduction", ("evaluate", "table2", "fetch", "viz", "viz3d")),
+    ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
+    ("paper reproduction", ("env_models", "evaluate", "table2", "fetch", "viz", "viz3d")),
     ("cli", ("cli", "__init__")),
 ]
 

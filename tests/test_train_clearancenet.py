@@ -8,12 +8,14 @@ import gdnplan as gp
 from gdnplan.data import make_shard
 from gdnplan.evaluate import predict
 from gdnplan.models import clearancenet as cn
-from gdnplan.train_clearancenet import train
+from gdnplan.train import FitConfig, train_clearancenet
 
 
 def test_short_training_beats_constant_and_round_trips(tmp_path):
     ds = make_shard("b", 0, 0, 1500)
-    model = train("b", ds, cn.ClearanceNetConfig.for_env("b", hidden=(64, 64)), epochs=15)
+    model = train_clearancenet(
+        "b", ds, cn.ClearanceNetConfig.for_env("b", hidden=(64, 64)), FitConfig(epochs=15)
+    )
     test = make_shard("b", 1, 0, 300)
     d, g = predict(model, test, grad=True)
     assert np.mean(np.abs(d - test.d)) < 0.8 * np.mean(np.abs(test.d - np.median(ds.d)))
@@ -25,3 +27,13 @@ def test_short_training_beats_constant_and_round_trips(tmp_path):
     np.testing.assert_allclose(g2, g)
     scene = test.scene(0)
     assert again.distance(scene, test.q[:1])[0] == pytest.approx(d[0], abs=1e-6)
+
+
+def test_old_module_and_keywords_still_work_with_a_deprecation_warning():
+    from gdnplan.train_clearancenet import train
+
+    ds = make_shard("b", 0, 0, 40)
+    config = cn.ClearanceNetConfig.for_env("b", hidden=(8,))
+    with pytest.warns(DeprecationWarning, match="FitConfig"):
+        model = train("b", ds, config, epochs=2, batch=8)
+    assert model.card["training"]["epochs"] == 2 and model.card["training"]["batch"] == 8

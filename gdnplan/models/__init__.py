@@ -66,9 +66,9 @@ def load_model(weights: Path | str, threads: int | None = None) -> DistanceModel
     path = weights_file(weights)
     kind = read_card(path).get("model")
     if kind == "graphdistnet":
-        from .graphdistnet import load_graphdistnet
+        from .graphdistnet import load_graphdistnet_weights
 
-        return load_graphdistnet(path, threads)
+        return load_graphdistnet_weights(path, threads)
     if kind == "clearancenet":
         from .clearancenet import load as load_clearancenet
 

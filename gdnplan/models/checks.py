@@ -7,19 +7,17 @@ What "fit the scene" means (:func:`check_fits`):
 * the robot: a card names the robot its network was trained for (``"robot"``, else the robot
   of its ``"env"``; ClearanceNet's config also fixes the joint count ``dof``). Another robot is
   an error: GraphDistNet's graph input accepts any robot, but its estimates for a robot it never
-  saw are meaningless (issue #19 measured (a)'s planar2 weights on (d)'s planar7 scenes rating
-  28 % of colliding configurations free). The robot's node count is not compared: the fetch
-  robot's graph grows with the gripper's stick, and the ur5e weights are trained on those
-  variants.
+  saw are meaningless (docs/decisions.md, "Training and models"). The robot's node count is not
+  compared: the fetch robot's graph grows with the gripper's stick, and the ur5e weights are
+  trained on those variants.
 * the obstacle layout: GraphDistNet reads the obstacles as a graph, so weights trained on one
   layout are used on others of the same robot; that is what the weights of the random
-  environments (b), (d), (e) are for. Measured with the shipped weights (300 configurations on
-  each of 10 scenes): (a)'s weights on (b) scenes rate 3.8 % of colliding configurations free,
-  (b)'s 1.0 %; (c)'s on (d) 2.5 %, (d)'s 4.5 %. So no error. ClearanceNet, by contrast, takes a
-  fixed-size vector of obstacle poses: trained on a fixed layout ((a), (c)) it never saw that
-  vector change, and on other layouts it rates 73 % ((a) on (b)) and 80 % ((c) on (d)) of
-  colliding configurations free. ClearanceNet weights of a fixed layout therefore only accept
-  that layout, and its pose encoding only squares (4-vertex obstacles).
+  environments (b), (d), (e) are for, and the shipped weights of a fixed layout stay usable on
+  the random layouts of their robot. ClearanceNet, by contrast, takes a fixed-size vector of
+  obstacle poses: trained on a fixed layout ((a), (c)) it never saw that vector change, and it
+  rates most colliding configurations of other layouts free. ClearanceNet weights of a fixed
+  layout therefore only accept that layout, and its pose encoding only squares (4-vertex
+  obstacles). The measurements behind both rules: docs/decisions.md.
 """
 
 from __future__ import annotations

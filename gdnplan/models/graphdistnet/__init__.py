@@ -62,7 +62,7 @@ prove it equal to :meth:`GraphDistNet.forward` (values and gradients).
 Modules: :mod:`.config` (options), :mod:`.geometry` (candidates, ring distances),
 :mod:`.layers` (MLPs, readout softmax, ring messages), :mod:`.network` (the module and its
 padded forward), :mod:`.lean` (the lean inference path), :mod:`.model` (the DistanceModel
-wrapper), :mod:`.load` (weights files).
+wrapper), :mod:`.load` (weights files: :func:`load_graphdistnet_weights`).
 """
 
 from .config import GraphDistNetConfig
@@ -77,7 +77,7 @@ from .geometry import (
 )
 from .layers import LEAKY_SLOPE, _activation, _LeakyRingMessages, masked_softmax, mlp
 from .lean import LeanInference, ObstacleFeatures, SceneGraph, _cross_mix, _softmax_small
-from .load import load_graphdistnet
+from .load import load_graphdistnet, load_graphdistnet_weights
 from .model import CHUNK_NODES, GraphDistNetModel, _repeat, _SceneCache, _Tape
 from .network import GraphDistNet, Union
 
@@ -102,6 +102,7 @@ __all__ = [
     "_repeat",
     "_softmax_small",
     "load_graphdistnet",
+    "load_graphdistnet_weights",
     "masked_softmax",
     "mlp",
     "nearest_candidates",

@@ -1,4 +1,11 @@
-"""GraphDistNet options: :class:`GraphDistNetConfig`, its presets and its dict form."""
+"""GraphDistNet's architecture: :class:`GraphDistNetConfig`, its presets and its dict form.
+
+The loss and schedule of its training are training settings (:mod:`gdnplan.train`:
+``GraphDistNetLoss``, ``FitConfig``). Cards written before that split hold the loss weights in
+their flat ``config``; :meth:`GraphDistNetConfig.from_dict` skips them (``LOSS_KEYS``), and
+``gdnplan.train.split_config`` reads them as the loss. Options that were removed
+(``REMOVED``) load at their former default value and are refused at any other.
+"""
 
 from __future__ import annotations
 
@@ -12,27 +19,20 @@ from ...errors import InputError
 
 @dataclass(frozen=True)
 class GraphDistNetConfig:
-    """Architecture, normalisation and loss options of GraphDistNet.
+    """Architecture and normalisation of GraphDistNet (activation: LeakyReLU, slope 0.2, the
+    paper's; graph edges are the polygons' own, not densified).
 
     Attributes:
         layers: K message-passing layers.
         hidden: d_h, node feature size.
         mlp: hidden widths of each h_k.
         readout: hidden widths of the final MLP.
-        activation: ``"leaky_relu"`` (slope 0.2, the paper) or ``"silu"``.
         cross: ``"argmax"`` (paper: random, then argmax partner) or ``"soft_knn"``.
         cross_k: candidates k of ``soft_knn`` (k + 1 nearest nodes are looked at).
         two_way: cross edges into both graphs (the paper). False: only robot nodes take a
             cross partner (obstacle nodes have z̄_i = z_i), so the obstacle features depend on
             the scene alone and inference computes them once per scene (package docstring).
         tau: initial temperature τ of ``soft_knn`` (normalised units², learned per layer).
-        max_edge: densify graph edges longer than this (m), or None.
-        grad_weight: weight λ of the gradient loss λ · (1 − cos(∂d̂/∂q, ∂f/∂q)).
-        grad_norm_weight: weight ν of the slope loss ν · ((|∂d̂/∂q| − |∂f/∂q|) / scale)²
-            (trained with ``grad_weight`` > 0 only; the cosine leaves the slope free).
-        contact_weight: extra weight μ of samples near contact in the distance loss,
-            w = 1 + μ · exp(−|f| / contact_scale) (0 = paper: every sample alike).
-        contact_scale: distance (m) over which the contact weight decays.
         node_distance: distance-aware nodes (beyond the paper): every layer's h_k also takes
             s_i, node i's signed distance to the other graph's polygons (normalised units,
             negative inside), as an absolute input (package docstring).
@@ -56,16 +56,10 @@ class GraphDistNetConfig:
     hidden: int = 32
     mlp: tuple[int, ...] = (32, 32, 32)
     readout: tuple[int, ...] = (32, 32, 32)
-    activation: str = "leaky_relu"
     cross: str = "soft_knn"
     cross_k: int = 4
     two_way: bool = True
     tau: float = 0.02
-    max_edge: float | None = None
-    grad_weight: float = 0.0
-    grad_norm_weight: float = 0.0
-    contact_weight: float = 0.0
-    contact_scale: float = 0.02
     node_distance: bool = False
     min_readout: bool = False
     tau_min: float = 1e-3
@@ -79,18 +73,10 @@ class GraphDistNetConfig:
             value = getattr(self, f.name)
             if any(isinstance(v, float) and not math.isfinite(v) for v in np.ravel(value)):
                 raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
-        if self.activation not in ("leaky_relu", "silu"):
-            raise InputError(
-                f"activation: expected 'leaky_relu' or 'silu', got {self.activation!r}"
-            )
         if self.cross not in ("argmax", "soft_knn"):
             raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
         if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
             raise InputError("layers, hidden, cross_k and scale must be positive")
-        if self.grad_norm_weight < 0 or (self.grad_norm_weight > 0 and self.grad_weight <= 0):
-            raise InputError("grad_norm_weight must be ≥ 0, and needs grad_weight > 0")
-        if self.contact_weight < 0 or self.contact_scale <= 0:
-            raise InputError("contact_weight must be ≥ 0 and contact_scale positive")
         if self.min_readout and not self.node_distance:
             raise InputError("min_readout needs node_distance=True (it reads the node distances)")
         if self.tau_min <= 0:
@@ -102,7 +88,7 @@ class GraphDistNetConfig:
 
     @classmethod
     def faithful(cls, **changes) -> GraphDistNetConfig:
-        """The paper's network: random/argmax partners, LeakyReLU, distance loss only."""
+        """The paper's network: random/argmax partners, LeakyReLU."""
         return cls(cross="argmax", **changes)
 
     @classmethod
@@ -115,15 +101,37 @@ class GraphDistNetConfig:
 
     @classmethod
     def from_dict(cls, data: dict) -> GraphDistNetConfig:
+        """The architecture of a card's ``config`` (module docstring: loss weights of old flat
+        cards are skipped, removed options accepted at their former default only)."""
+        data = {k: v for k, v in dict(data).items() if k not in LOSS_KEYS}
+        for key, default in REMOVED.items():
+            value = data.pop(key, default)
+            if value != default:
+                raise InputError(
+                    f"config: {key} = {value!r}: the option was removed (only its former "
+                    f"default {default!r} is accepted); drop it from the config or retrain"
+                )
         known = {f.name for f in fields(cls)}
         unknown = set(data) - known
         if unknown:
             raise InputError(f"config: unknown GraphDistNet options {sorted(unknown)}")
-        data = dict(data)
         for key in ("mlp", "readout", "origin"):
             if key in data:
                 data[key] = tuple(data[key])
         return cls(**data)
 
     def with_(self, **changes) -> GraphDistNetConfig:
+        """A copy with ``changes`` (architecture fields; InputError naming a loss weight)."""
+        loss = sorted(set(changes) & set(LOSS_KEYS))
+        if loss:
+            raise InputError(
+                f"config: {loss} are loss weights, not architecture; set them in "
+                "gdnplan.train.GraphDistNetLoss"
+            )
         return replace(self, **changes)
+
+
+# Loss weights that old flat cards keep in their config (training settings now).
+LOSS_KEYS = ("grad_weight", "grad_norm_weight", "contact_weight", "contact_scale")
+# Removed options -> the one value they had in every card (accepted, and dropped).
+REMOVED = {"activation": "leaky_relu", "max_edge": None}

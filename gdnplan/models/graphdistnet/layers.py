@@ -12,17 +12,17 @@ from torch import nn
 LEAKY_SLOPE = 0.2  # negative slope of the paper's LeakyReLU
 
 
-def _activation(name: str) -> nn.Module:
-    return nn.LeakyReLU(LEAKY_SLOPE) if name == "leaky_relu" else nn.SiLU()
+def _activation() -> nn.Module:
+    return nn.LeakyReLU(LEAKY_SLOPE)
 
 
-def mlp(sizes: list[int], activation: str) -> nn.Sequential:
-    """Linear layers of ``sizes`` with the activation between them (none after the last)."""
+def mlp(sizes: list[int]) -> nn.Sequential:
+    """Linear layers of ``sizes`` with LeakyReLU between them (none after the last)."""
     mods: list[nn.Module] = []
     for i, (a, b) in enumerate(itertools.pairwise(sizes)):
         mods.append(nn.Linear(a, b))
         if i < len(sizes) - 2:
-            mods.append(_activation(activation))
+            mods.append(_activation())
     return nn.Sequential(*mods)
 
 

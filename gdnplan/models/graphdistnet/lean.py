@@ -222,17 +222,11 @@ class LeanInference:
         v = z @ first.weight[:, d:].T
         b, n, hd = v.shape
         c = self._node_term(k, mix(v) - v + first.bias, s)  # (B, N, H): the self edge
-        if rest and self.config.activation == "leaky_relu":
-            hidden = [m for m in rest[:-1] if isinstance(m, nn.Linear)]
-            msg = _LeakyRingMessages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
-        else:
+        if not rest:
             ring_edges = u.index_select(1, ring).view(b, 2, n, hd) - u[:, None] + c[:, None]
-            pre = torch.cat([ring_edges, c[:, None]], 1)  # (B, 3, N, H)
-            if not rest:
-                return pre.sum(1)
-            for module in rest[:-1]:
-                pre = module(pre)
-            msg = pre.sum(1)
+            return torch.cat([ring_edges, c[:, None]], 1).sum(1)  # (B, 3, N, H) summed
+        hidden = [m for m in rest[:-1] if isinstance(m, nn.Linear)]
+        msg = _LeakyRingMessages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
         last = rest[-1]
         return nn.functional.linear(msg, last.weight, 3 * last.bias)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 from ..checks import build_net, card_config, check_count
@@ -12,9 +13,10 @@ from .model import GraphDistNetModel
 from .network import GraphDistNet
 
 
-def load_graphdistnet(path: Path | str, threads: int | None = None) -> GraphDistNetModel:
-    """A :class:`GraphDistNetModel` from ``path`` (safetensors) and the JSON card beside it,
-    running inference with ``threads`` torch threads (None: the library default, 1)."""
+def load_graphdistnet_weights(path: Path | str, threads: int | None = None) -> GraphDistNetModel:
+    """A :class:`GraphDistNetModel` from the weights file ``path`` (safetensors) and the JSON
+    card beside it, running inference with ``threads`` torch threads (None: the library
+    default, 1). Old flat cards load unchanged (:mod:`.config`)."""
     threads = check_threads(threads)
     path = Path(path)
     tensors, card = read_weights(path)
@@ -24,3 +26,14 @@ def load_graphdistnet(path: Path | str, threads: int | None = None) -> GraphDist
     check_count(len(config.readout) or 1, len(tensors), "readout", path)
     net = build_net(path, "GraphDistNet", lambda: GraphDistNet(config), tensors)
     return GraphDistNetModel(net, card, threads=threads)
+
+
+def load_graphdistnet(path: Path | str, threads: int | None = None) -> GraphDistNetModel:
+    """Deprecated name of :func:`load_graphdistnet_weights` (a weights file by path)."""
+    warnings.warn(
+        "gdnplan.models.graphdistnet.load_graphdistnet is deprecated; use "
+        "load_graphdistnet_weights (a file) or gdnplan.load_model (a file or a shipped name)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return load_graphdistnet_weights(path, threads)

@@ -68,11 +68,9 @@ class GraphDistNetModel:
         cached = self._scenes.get(scene)
         if cached is None:
             self.check_scene(scene)
-            graph = robot_graph(scene.robot, self.config.max_edge)
+            graph = robot_graph(scene.robot)
             polys, sizes = scene_obstacles([scene])
-            obstacles = obstacle_graph(
-                polys, sizes, self.config.max_edge, device=self.device, dtype=self.dtype
-            )
+            obstacles = obstacle_graph(polys, sizes, None, device=self.device, dtype=self.dtype)
             lean = (
                 self.net.scene_graph(graph, obstacles) if self.config.cross == "soft_knn" else None
             )

@@ -43,11 +43,11 @@ class GraphDistNet(LeanInference, nn.Module):
         self.convs = nn.ModuleList()
         for k in range(c.layers):
             d_in = 2 if k == 0 else 2 + c.hidden  # size of z_i
-            self.convs.append(mlp([2 * d_in, *c.mlp, c.hidden], c.activation))
+            self.convs.append(mlp([2 * d_in, *c.mlp, c.hidden]))
         self.attention = nn.Parameter(torch.randn(c.layers, c.hidden) / math.sqrt(c.hidden))
         self.log_tau = nn.Parameter(torch.full((c.layers,), math.log(c.tau)))
-        self.head = mlp([2 * c.hidden + int(c.min_readout), *c.readout, 1], c.activation)
-        self.out_act = _activation(c.activation)
+        self.head = mlp([2 * c.hidden + int(c.min_readout), *c.readout, 1])
+        self.out_act = _activation()
         if c.node_distance:  # w_k: s_i w_k joins the first linear layer of h_k on every edge
             width = (c.mlp or (c.hidden,))[0]
             self.distance_in = nn.Parameter(torch.empty(c.layers, width).uniform_(-1.0, 1.0))

@@ -1,0 +1,77 @@
+"""Shards of a split: samples ``start … start + n − 1`` of an environment with a seed.
+
+A sample is a configuration q drawn uniformly within the joint limits, the obstacle polygons of
+its scene and the coal labels: the signed distance f_cd(q) (m) and its gradient ∂f/∂q (m/rad).
+Fixed environments (a, c) share one scene; random environments (b, d, e) draw a new obstacle
+set per sample with ``make_scene(env, seed=scene_seed)``, where
+
+    scene_seed = seed · 10⁸ + index     (index = position of the sample in the split),
+
+so a split is a pure function of (env, seed, n) and train (seed 0) and test (seed 1) never
+share a scene. ``ur5e`` samples: :mod:`.ur5e_samples`.
+
+For the environments a–e, ``near`` > 0 concentrates that fraction of the samples at the
+collision boundary (beyond the paper, for AUC and gradients where they matter): a
+near-boundary sample is q uniform within the limits conditioned on |f(q)| < ``BOUNDARY_BAND``,
+drawn by rejection (uniform candidates labelled by coal, the first ones inside the band kept).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..distance import signed_distance, signed_distance_and_grad
+from ..errors import InputError
+from ..geometry import pad_polygons
+from ..scene import Scene, make_scene
+from .dataset import Dataset
+from .ur5e_samples import make_ur5e_shard
+
+RANDOM_ENVS = ("b", "d", "e")
+BOUNDARY_BAND = 0.03  # m: near-boundary samples of a–e have |f| below this
+
+
+def near_boundary(scene: Scene, k: int, rng: np.random.Generator) -> np.ndarray:
+    """(k, dof) configurations uniform within the limits conditioned on |f| < BOUNDARY_BAND
+    (rejection sampling in batches of uniform candidates labelled by coal)."""
+    robot = scene.robot
+    batch = min(4096, max(256, 40 * k))
+    kept = [np.empty((0, robot.dof))]
+    found = 0
+    for _ in range(10_000):
+        if found >= k:
+            return np.concatenate(kept)[:k]
+        candidates = robot.sample(batch, seed=rng.integers(2**63))
+        inside = candidates[np.abs(signed_distance(scene, candidates)) < BOUNDARY_BAND]
+        kept.append(inside)
+        found += len(inside)
+    raise InputError(f"near: no configurations within {BOUNDARY_BAND} m of contact in {scene.name}")
+
+
+def make_shard(env: str, seed: int, start: int, n: int, near: float = 0.0) -> Dataset:
+    """Samples ``start … start + n − 1`` of the split of ``env`` with ``seed`` (``near``:
+    fraction of near-contact samples, see the module docstring)."""
+    if env == "ur5e":
+        return make_ur5e_shard(seed, start, n, near)
+    base = make_scene(env, seed=0)
+    robot = base.robot
+    q = robot.sample(n, seed=[seed, start])
+    scene_seed = seed * 10**8 + start + np.arange(n, dtype=np.int64)
+    rng = np.random.default_rng([seed, start, 11])
+    is_near = rng.random(n) < near if near > 0 else np.zeros(n, bool)
+    if env in RANDOM_ENVS:
+        scenes = [make_scene(env, seed=int(s)) for s in scene_seed]
+        for i in np.flatnonzero(is_near):
+            q[i] = near_boundary(scenes[i], 1, rng)[0]
+        labels = [signed_distance_and_grad(s, qi[None]) for s, qi in zip(scenes, q, strict=True)]
+        d = np.concatenate([lab[0] for lab in labels])
+        grad = np.concatenate([lab[1] for lab in labels])
+        polys = [list(s.obstacles) for s in scenes]
+    else:
+        q[is_near] = near_boundary(base, int(is_near.sum()), rng)
+        chunks = [signed_distance_and_grad(base, c) for c in np.array_split(q, -(-n // 500))]
+        d, grad = (np.concatenate(x) for x in zip(*chunks, strict=True))  # no nested pools
+        polys = [list(base.obstacles)] * n
+    obstacles, sizes = pad_polygons(polys)
+    nodes = robot.node_positions(q).astype(np.float32)
+    return Dataset(env, q, nodes, obstacles, sizes, d, grad, scene_seed)

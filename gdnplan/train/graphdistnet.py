@@ -1,0 +1,329 @@
+"""Training GraphDistNet on the datasets of :mod:`gdnplan.data`: :func:`train` with its
+:class:`TrainConfig` (architecture, loss, schedule, data), through the shared loop
+:func:`gdnplan.train.fit.fit`.
+
+The loss is :mod:`.loss`'s; ∂d̂/∂q for its gradient terms comes from the node Jacobians
+(:mod:`.tensors`). Model selection scores the validation split by the loss's terms,
+MAE / scale + λ · ACD (λ = ``grad_weight``; the ACD only when λ > 0). Each epoch writes a
+checkpoint in the run directory, so an interrupted run resumes where it stopped; fine-tuning
+(``init``) lets the starting weights compete with every epoch. The weights' card records the
+architecture (``config``), the loss and schedule (``training``), the data, the test metrics
+and the git commit.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+import torch
+from safetensors.torch import load_file
+
+from ..data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
+from ..errors import InputError
+from ..metrics import roc_auc, sha256_prefix, used_cosine_distances
+from ..models.graphdistnet import GraphDistNet, GraphDistNetConfig
+from ..models.weights import read_card
+from .checkpoint import check_resume
+from .fit import FitConfig, fit, validation_split
+from .loss import GraphDistNetLoss, distance_loss, gradient_loss
+from .report import evaluate, git_sha, plot_losses, save_weights
+from .tensors import Tensors, forward_with_grad, predict, tensors
+
+OUT_DIR = Path("weights")  # default output folder of trained weights (working directory)
+RUNS_DIR = Path("runs")  # default run folders (checkpoints, logs), working directory
+PRESETS = {"faithful": GraphDistNetConfig.faithful, "smooth": GraphDistNetConfig.smooth}
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """One GraphDistNet training run, one field per concern.
+
+    Attributes:
+        network: the architecture (``scale`` and ``origin`` are set from the robot).
+        loss: the loss weights.
+        fit: the schedule (batch, lr, epochs, patience, time budget, seed, device).
+        n_train: use only the first n samples of ``data/<env>/train`` (incl. the 10 %
+            validation part), or None for all.
+        extra: more training splits (directories of shards, e.g. near-boundary samples from
+            ``gdnplan generate --near``), added to the training part only: validation stays
+            the 10 % of ``data/<env>/train``, the distribution of the test split.
+        init: fine-tune: start from these weights (same architecture as ``network``) instead
+            of a random initialisation; ignored when the run resumes from its checkpoint.
+        compile: ``torch.compile`` the training step; validation and evaluation stay eager.
+    """
+
+    network: GraphDistNetConfig = field(default_factory=GraphDistNetConfig.smooth)
+    loss: GraphDistNetLoss = field(default_factory=GraphDistNetLoss)
+    fit: FitConfig = field(default_factory=FitConfig)
+    n_train: int | None = None
+    extra: tuple[Path | str, ...] = ()
+    init: Path | str | None = None
+    compile: bool = False
+
+    def __post_init__(self) -> None:
+        n = self.n_train
+        if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 2):
+            raise InputError(f"n_train: expected an integer ≥ 2, got {n!r}")
+        if self.compile and self.loss.grad_weight > 0:
+            raise InputError(
+                "compile: the gradient loss (grad_weight > 0) differentiates ∂d̂/∂q, a double "
+                "backward that torch.compile does not support; train it without --compile"
+            )
+        object.__setattr__(self, "extra", tuple(self.extra))
+
+
+def split_config(flat: dict) -> tuple[GraphDistNetConfig, GraphDistNetLoss]:
+    """The architecture and the loss of one flat dict (an old card's ``config``, or a new
+    card's ``config`` with its ``training.loss``, plus ``--set`` overrides)."""
+    return GraphDistNetConfig.from_dict(flat), GraphDistNetLoss.from_dict(flat)
+
+
+def card_settings(weights: Path | str, what: str = "--init") -> dict:
+    """The flat settings (architecture and loss) recorded in the card of ``weights``."""
+    card = read_card(weights, what)
+    config = card.get("config")
+    if not isinstance(config, dict):
+        raise InputError(f"{what}: the card of {weights} has no 'config' object")
+    training = card.get("training")
+    loss = training.get("loss") if isinstance(training, dict) else None
+    return {**config, **(loss if isinstance(loss, dict) else {})}
+
+
+def check_env(ds: Dataset, env: str, where: Path | str) -> Dataset:
+    """``ds`` when its samples are of environment ``env``; InputError naming both otherwise."""
+    if ds.env != env:
+        raise InputError(
+            f"data: {where} holds samples of environment {ds.env!r}, not {env!r}; generate "
+            f"them with `gdnplan generate --env {env}` or train with --env {ds.env}"
+        )
+    return ds
+
+
+def _load_init(net: GraphDistNet, path: Path) -> None:
+    """Load the weights at ``path`` into ``net``; InputError if missing or of another shape.
+
+    Weights without the ``node_distance`` input w_k start a ``node_distance`` network at
+    w_k = 0, the function of the loaded network, which then learns to use s_i. Weights of a
+    plain readout start a ``correction_band`` network with the head's m input at weight 0 (and
+    τ_m at ``tau_min``): its MLP is then the loaded estimate, used in and near overlap.
+    """
+    if not path.exists():
+        raise InputError(f"--init: {path} does not exist")
+    state = load_file(str(path))
+    if net.config.node_distance and "distance_in" not in state:
+        state["distance_in"] = torch.zeros_like(net.distance_in)
+    first = state.get("head.0.weight")
+    if net.config.correction_band is not None and "log_tau_min" not in state and first is not None:
+        state["head.0.weight"] = torch.cat([first, first.new_zeros(len(first), 1)], 1)
+        state["log_tau_min"] = net.log_tau_min.detach().clone()
+    try:
+        net.load_state_dict(state)
+    except RuntimeError as e:
+        raise InputError(f"--init: {path} does not fit this architecture ({e})") from e
+
+
+def validate(
+    net: GraphDistNet, val_t: Tensors, loss: GraphDistNetLoss | None = None, device: str = "cpu"
+) -> dict:
+    """Validation MAE (m), AUC (logged, not used for selection) and the model-selection score:
+    the loss's terms, MAE / scale + λ · ACD (λ = ``grad_weight``; the ACD only when λ > 0)."""
+    loss = loss or GraphDistNetLoss()
+    val_hat, val_g = predict(net, val_t, device=device, grad=loss.grad_weight > 0)
+    val_d = val_t.d.double().numpy()
+    mae = float(np.mean(np.abs(val_hat - val_d)))
+    score = mae / net.config.scale
+    if val_g is not None:
+        cd = used_cosine_distances(val_g, val_t.grad.double().numpy())
+        score += loss.grad_weight * float(np.mean(cd))
+    return {"val_mae_m": mae, "val_auc": roc_auc(-val_hat, val_d <= 0), "val_score": score}
+
+
+class GraphDistNetLearner:
+    """GraphDistNet's part of :func:`~gdnplan.train.fit.fit`: its loss on training rows and
+    its validation score (``step_net``: the network the steps run, e.g. compiled)."""
+
+    def __init__(
+        self,
+        net: GraphDistNet,
+        train_t: Tensors,
+        val_t: Tensors,
+        weights: GraphDistNetLoss,
+        device: str = "cpu",
+        step_net: torch.nn.Module | None = None,
+    ):
+        self.net, self.train_t, self.val_t = net, train_t, val_t
+        self.weights, self.device = weights, device
+        self.step_net = step_net or net
+
+    def __len__(self) -> int:
+        return len(self.train_t)
+
+    def loss(self, rows: torch.Tensor, generator: torch.Generator) -> torch.Tensor:
+        t, dev, w, scale = self.train_t, self.device, self.weights, self.net.config.scale
+        robot, obstacles = t.batch(rows, dev)
+        if w.grad_weight > 0:
+            jac = t.jac[rows].to(dev)
+            d_hat, g_hat = forward_with_grad(self.step_net, robot, obstacles, jac, True, generator)
+            loss_g = gradient_loss(g_hat, t.grad[rows].to(dev), w, scale)
+        else:
+            d_hat = self.step_net(robot, obstacles, generator)
+            loss_g = torch.zeros((), device=dev)
+        return distance_loss(d_hat, t.d[rows].to(dev), w, scale) + loss_g
+
+    def validate(self) -> dict:
+        return validate(self.net, self.val_t, self.weights, self.device)
+
+
+LEGACY = ("n_train", "batch", "lr", "epochs", "patience", "time_budget", "seed", "device",
+          "compile", "init", "extra", "loss")  # fmt: skip
+
+
+def _legacy_config(config: GraphDistNetConfig | None, legacy: dict) -> TrainConfig:
+    """The TrainConfig of an old-style call ``train(env, GraphDistNetConfig, batch=…, …)``."""
+    unknown = sorted(set(legacy) - set(LEGACY))
+    if unknown:
+        raise TypeError(f"train() got unexpected keyword arguments {unknown}")
+    warnings.warn(
+        "train(env, GraphDistNetConfig, batch=…, lr=…, …) is deprecated; pass "
+        "gdnplan.train.TrainConfig(network=…, loss=…, fit=FitConfig(…), …)",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    names = {f.name for f in fields(FitConfig)}
+    schedule = FitConfig(**{k: v for k, v in legacy.items() if k in names})
+    rest = {k: v for k, v in legacy.items() if k not in names}
+    return TrainConfig(network=config or GraphDistNetConfig.smooth(), fit=schedule, **rest)
+
+
+def _datasets(env: str, c: TrainConfig, data_root: Path | str):
+    """(training tensors, validation tensors, extra sets) of the run (seeded split)."""
+    train_dir = split_dir(env, "train", data_root)
+    full = check_env(load(train_dir, c.n_train), env, train_dir)
+    if len(full) < 2:
+        raise InputError(f"data: {train_dir} holds {len(full)} sample; training needs ≥ 2")
+    tr, val = validation_split(len(full), c.fit.seed)
+    extra_sets = [check_env(load(path), env, path) for path in c.extra]
+    train_t = tensors(concat([full.subset(tr), *extra_sets]))
+    return train_t, tensors(full.subset(val)), extra_sets
+
+
+def train(
+    env: str,
+    config: TrainConfig | GraphDistNetConfig | None = None,
+    name: str = "smooth",
+    *,
+    data_root: Path | str = DATA_DIR,
+    out: Path | str | None = None,
+    run_dir: Path | str | None = None,
+    **legacy,
+) -> dict:
+    """Train GraphDistNet on ``data/<env>/train``, evaluate on ``data/<env>/test``, save weights.
+
+    Args:
+        env: environment name (its splits must exist, see :func:`gdnplan.data.generate`).
+        config: the run (:class:`TrainConfig`; None: its defaults). A bare
+            :class:`GraphDistNetConfig` with the old keywords (``batch=``, ``lr=``, …) still
+            works, deprecated.
+        name: run name (``runs/<env>-<name>``).
+        data_root: the folder of ``<env>/train`` and ``<env>/test``.
+        out: weights path (default ``weights/<env>.safetensors``; the card goes beside it).
+        run_dir: checkpoint and loss curve (default ``runs/<env>-<name>``).
+
+    Returns:
+        The card written beside the weights (config, data, training log, test metrics).
+    """
+    if legacy or not (config is None or isinstance(config, TrainConfig)):
+        config = _legacy_config(config, legacy)
+    c = config or TrainConfig()
+    robot = env_robot(env)
+    network = c.network.with_(
+        scale=round(robot.reach, 6), origin=tuple(float(v) for v in robot.chain.joint_origins[0])
+    )
+    run_dir = Path(run_dir or RUNS_DIR / f"{env}-{name}")
+    out = Path(out or OUT_DIR / f"{env}.safetensors")
+    device = c.fit.device
+    torch.manual_seed(c.fit.seed)
+    train_t, val_t, extra_sets = _datasets(env, c, data_root)
+    net = GraphDistNet(network).to(device)
+    if c.init is not None:
+        _load_init(net, Path(c.init))
+    step_net = torch.compile(net, dynamic=True) if c.compile else net
+    run_dir.mkdir(parents=True, exist_ok=True)  # after the checks of the data
+    ckpt = run_dir / "checkpoint.safetensors"
+    settings = _settings(c, network)
+    if ckpt.exists():
+        check_resume(read_card(ckpt, "resume"), json.loads(json.dumps(settings)), ckpt)
+    learner = GraphDistNetLearner(net, train_t, val_t, c.loss, device, step_net)
+    state = fit(
+        learner,
+        c.fit,
+        checkpoint=ckpt,
+        settings=settings,
+        start_weights=None if c.init is None else str(c.init),
+        desc=f"{env}-{name}",
+        echo=print,
+    )
+    plot_losses(state["log"], run_dir / "loss.png", f"{env}-{name}")
+    test_dir = split_dir(env, "test", data_root)
+    test = evaluate(net, check_env(load(test_dir), env, test_dir), device=device)
+    card = _card(env, name, robot.name, c, state, (train_t, val_t, extra_sets), test)
+    card["parameters"] = sum(p.numel() for p in net.parameters())
+    save_weights(net.cpu(), card, out)
+    return card
+
+
+def _settings(c: TrainConfig, network: GraphDistNetConfig) -> dict:
+    """What a resumed run must share with its checkpoint (architecture and loss flat)."""
+    return {
+        "config": {**network.to_dict(), **c.loss.to_dict()},
+        "batch": c.fit.batch,
+        "lr": c.fit.lr,
+        "seed": c.fit.seed,
+        "n_train": c.n_train,
+        "extra": [str(p) for p in c.extra],
+    }
+
+
+def _card(env: str, name: str, robot: str, c: TrainConfig, state: dict, data, test) -> dict:
+    """The weights card of a finished run (the caller adds the architecture and parameters)."""
+    train_t, val_t, extra_sets = data
+    log = state["log"]
+    card = {
+        "model": "graphdistnet",
+        "name": name,
+        "env": env,
+        "robot": robot,
+        "data": {
+            "train_dir": str(split_dir(env, "train", Path("data"))),
+            "train_seed": 0,
+            "n_train": len(train_t),
+            "n_val": len(val_t),
+            "extra": {str(p): len(ds) for p, ds in zip(c.extra, extra_sets, strict=True)},
+            "test_seed": 1,
+            "n_test": test["n"],
+        },
+        "training": {
+            "seed": c.fit.seed,
+            "batch": c.fit.batch,
+            "lr": c.fit.lr,
+            "loss": c.loss.to_dict(),
+            "epochs": len(log),
+            "best_val_score": state["best"],
+            "seconds": sum(e["seconds"] for e in log),
+            "samples_per_s": float(np.mean([e["samples_per_s"] for e in log])) if log else None,
+            "device": c.fit.device,
+            "threads": torch.get_num_threads(),
+            "compiled": c.compile,
+        },
+        "parameters": None,
+        "test": test,
+        "git_sha": git_sha(),
+    }
+    if c.init is not None:
+        card["init"] = {"path": str(c.init), "sha256_prefix": sha256_prefix(Path(c.init))}
+        card["init"].update(state.get("init_val", {}))
+    return card

@@ -1,0 +1,113 @@
+"""Writing splits (gdnplan.data.shards): resumable generation, manifests, bad input."""
+
+import numpy as np
+import pytest
+
+import gdnplan as gp
+from gdnplan import data
+from gdnplan.errors import InputError
+
+
+def _arrays(path):
+    ds = data.load(path)
+    return {f: getattr(ds, f) for f in data.FIELDS}
+
+
+def test_generate_is_resumable_and_load_concatenates(tmp_path, monkeypatch):
+    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    out = tmp_path / "b"
+    data.generate("b", 10, seed=1, out_dir=out, workers=1)
+    files = sorted(out.glob("shard_*.npz"))
+    assert len(files) == 3
+    stamps = [f.stat().st_mtime_ns for f in files]
+    files[1].unlink()
+    data.generate("b", 10, seed=1, out_dir=out, workers=1)
+    assert [f.stat().st_mtime_ns for f in sorted(out.glob("shard_*.npz"))][::2] == stamps[::2]
+    ds = data.load(out)
+    assert len(ds) == 10 and ds.env == "b"
+    shards = [data.make_shard("b", seed=1, start=s, n=min(4, 10 - s)) for s in (0, 4, 8)]
+    np.testing.assert_array_equal(ds.scene_seed, np.arange(10) + 10**8)
+    np.testing.assert_allclose(ds.d, np.concatenate([s.d for s in shards]))
+    assert len(data.load(out, n=5)) == 5
+
+
+def test_bad_inputs_raise(tmp_path):
+    with pytest.raises(gp.UnknownNameError):
+        data.generate("z", 10, 0, tmp_path)
+    with pytest.raises(gp.InputError):
+        data.generate("a", 0, 0, tmp_path)
+    with pytest.raises(gp.InputError):
+        data.load("/nonexistent/dir")
+
+
+@pytest.mark.parametrize("sizes", [(3, 7), (4, 9), (1, 2, 8), (5, 5)])
+def test_resume_with_a_larger_n_equals_a_one_shot_run(tmp_path, monkeypatch, sizes):
+    """generate n₁ then n₂ > n₁ into one folder = generate n₂ once (same shards, same samples)."""
+    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    once, resumed = tmp_path / "once", tmp_path / "resumed"
+    data.generate("a", sizes[-1], seed=2, out_dir=once, workers=1)
+    for n in sizes:
+        data.generate("a", n, seed=2, out_dir=resumed, workers=1)
+    names = sorted(p.name for p in once.iterdir())
+    assert sorted(p.name for p in resumed.iterdir()) == names
+    assert "manifest.json" in names and not [n for n in names if n.startswith(".")]
+    a, b = _arrays(once), _arrays(resumed)
+    assert len(b["q"]) == sizes[-1]
+    for f in data.FIELDS:
+        np.testing.assert_array_equal(a[f], b[f], err_msg=f)
+
+
+def test_resume_keeps_complete_shards_and_remakes_the_short_last_one(tmp_path, monkeypatch):
+    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    data.generate("a", 6, seed=0, out_dir=tmp_path, workers=1)  # shards of 4 and 2
+    first, second = tmp_path / "shard_0000.npz", tmp_path / "shard_0001.npz"
+    stamps = first.stat().st_mtime_ns, second.stat().st_mtime_ns
+    data.generate("a", 8, seed=0, out_dir=tmp_path, workers=1)
+    assert first.stat().st_mtime_ns == stamps[0] and second.stat().st_mtime_ns != stamps[1]
+    assert len(data.load(tmp_path)) == 8
+
+
+@pytest.mark.parametrize(
+    ("change", "option"),
+    [({"env": "c"}, "--env"), ({"seed": 1}, "--seed"), ({"near": 0.5}, "--near")],
+)
+def test_resume_with_other_settings_is_refused(tmp_path, monkeypatch, change, option):
+    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    settings = {"env": "a", "seed": 0, "near": 0.0}
+    data.generate(n=5, out_dir=tmp_path, workers=1, **settings)
+    before = {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()}
+    with pytest.raises(InputError, match=f"^{option}: .*manifest.json"):
+        data.generate(n=9, out_dir=tmp_path, workers=1, **(settings | change))
+    assert {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()} == before
+
+
+def test_a_smaller_n_and_unrecorded_shards_are_refused(tmp_path, monkeypatch):
+    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    data.generate("a", 9, seed=0, out_dir=tmp_path, workers=1)
+    for n in (8, 5, 3):  # fewer shards, or a shorter last shard
+        with pytest.raises(InputError, match=r"^--n: .*holds 9 samples.*n ≥ 9"):
+            data.generate("a", n, seed=0, out_dir=tmp_path, workers=1)
+    assert len(data.load(tmp_path)) == 9
+    (tmp_path / "manifest.json").unlink()
+    with pytest.raises(InputError, match=r"no manifest\.json"):
+        data.generate("a", 9, seed=0, out_dir=tmp_path, workers=1)
+    (tmp_path / "manifest.json").write_text("[1, 2")
+    with pytest.raises(InputError, match="not a readable manifest"):
+        data.generate("a", 9, seed=0, out_dir=tmp_path, workers=1)
+
+
+def test_an_interrupted_shard_leaves_no_temp_and_is_made_on_resume(tmp_path, monkeypatch):
+    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    real = np.savez_compressed
+
+    def interrupted(f, **arrays):
+        f.write(b"PK\x03\x04 half a zip")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez_compressed", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        data.generate("a", 6, seed=0, out_dir=tmp_path, workers=1)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["manifest.json"]
+    monkeypatch.setattr(np, "savez_compressed", real)
+    data.generate("a", 6, seed=0, out_dir=tmp_path, workers=1)
+    assert len(data.load(tmp_path)) == 6

@@ -1,0 +1,144 @@
+"""The one training loop (gdnplan.train.fit) against a reference transcription of the loops it
+replaced, bit for bit, for both learned models; and its schedule's checks."""
+
+import math
+from functools import cache
+
+import numpy as np
+import pytest
+import torch
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gdnplan.data import make_shard
+from gdnplan.errors import InputError
+from gdnplan.models.clearancenet import ClearanceNet, ClearanceNetConfig
+from gdnplan.models.graphdistnet import GraphDistNet, GraphDistNetConfig
+from gdnplan.train import (
+    ClearanceNetLearner,
+    FitConfig,
+    GraphDistNetLearner,
+    GraphDistNetLoss,
+    fit,
+    tensors,
+    validation_split,
+)
+
+
+def reference_fit(learner, c: FitConfig) -> list[tuple[float, float]]:
+    """The loop of the former ``train.train`` / ``train_clearancenet.train``, written out:
+    per epoch a (seed, epoch) permutation, Adam steps, validation; the learning rate halved
+    after 3 stale epochs, a stop after ``patience``, the best state restored.
+    Returns (validation score, learning rate) per epoch."""
+    net, n = learner.net, len(learner)
+    opt = torch.optim.Adam(net.parameters(), lr=c.lr)
+    best, best_state, stale, plateau, log = math.inf, None, 0, 0, []
+    for epoch in range(c.epochs):
+        if stale >= c.patience:
+            break
+        net.train()
+        perm = torch.as_tensor(np.random.default_rng([c.seed, epoch]).permutation(n))
+        gen = torch.Generator().manual_seed(c.seed * 100_003 + epoch)
+        for s in range(0, n, c.batch):
+            loss = learner.loss(perm[s : s + c.batch], gen)
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+        score = learner.validate()["val_score"]
+        log.append((score, opt.param_groups[0]["lr"]))
+        if score < best:
+            best, stale, plateau = score, 0, 0
+            best_state = {k: v.detach().clone() for k, v in net.state_dict().items()}
+        else:
+            stale, plateau = stale + 1, plateau + 1
+            if plateau >= 3:
+                plateau = 0
+                for g in opt.param_groups:
+                    g["lr"] /= 2
+    net.load_state_dict(best_state)
+    return log
+
+
+@cache
+def shard(env: str, n: int):
+    return make_shard(env, 0, 0, n)
+
+
+def clearancenet_learner(seed: int) -> ClearanceNetLearner:
+    ds = shard("d", 200)  # env d: dropout 0.5, drawn from torch's global generator
+    torch.manual_seed(seed)
+    tr, val = validation_split(len(ds), seed)
+    return ClearanceNetLearner(
+        ClearanceNet(ClearanceNetConfig.for_env("d", hidden=(16,))), ds, tr, val
+    )
+
+
+def graphdistnet_learner(seed: int, cross: str) -> GraphDistNetLearner:
+    ds = shard("a", 40)
+    torch.manual_seed(seed)
+    tr, val = validation_split(len(ds), seed)
+    net = GraphDistNet(GraphDistNetConfig(layers=1, hidden=8, mlp=(8,), readout=(8,), cross=cross))
+    loss = GraphDistNetLoss(grad_weight=0.1, contact_weight=2.0)
+    return GraphDistNetLearner(net, tensors(ds.subset(tr)), tensors(ds.subset(val)), loss)
+
+
+LEARNERS = {
+    "clearancenet": lambda seed: clearancenet_learner(seed),
+    "graphdistnet soft_knn": lambda seed: graphdistnet_learner(seed, "soft_knn"),
+    "graphdistnet argmax": lambda seed: graphdistnet_learner(seed, "argmax"),  # random partners
+}
+
+
+@pytest.mark.parametrize("model", sorted(LEARNERS))
+def test_fit_equals_the_reference_loop_bit_for_bit(model):
+    """Same seed, same weights and the same validation scores and learning rates per epoch; a
+    learning rate that overshoots makes the run halve it and stop early, so every branch runs."""
+    c = FitConfig(batch=16, lr=0.3, epochs=12, patience=4, seed=3)
+    a = LEARNERS[model](c.seed)  # each seeds torch's global generator (dropout) when built
+    expected = reference_fit(a, c)
+    b = LEARNERS[model](c.seed)
+    state = fit(b, c)
+    assert [(e["val_score"], e["lr"]) for e in state["log"]] == expected
+    assert any(lr < c.lr for _, lr in expected) and len(expected) < c.epochs
+    assert state["best"] == min(score for score, _ in expected)
+    sa, sb = a.net.state_dict(), b.net.state_dict()
+    assert sa.keys() == sb.keys() and all(torch.equal(sa[k], sb[k]) for k in sa)
+
+
+def test_fit_stops_at_the_time_budget_and_keeps_the_starting_weights_when_asked():
+    learner = clearancenet_learner(0)
+    start = {k: v.clone() for k, v in learner.net.state_dict().items()}
+    state = fit(learner, FitConfig(lr=0.0, epochs=5, time_budget=1e-9), start_weights="start")
+    assert len(state["log"]) == 1  # the budget is checked before each epoch
+    assert all(torch.equal(start[k], v) for k, v in learner.net.state_dict().items())
+    assert state["best"] == state["init_val"]["val_score"]
+
+
+@settings(max_examples=30, deadline=None)
+@given(n=st.integers(2, 500), seed=st.integers(0, 2**32 - 1))
+def test_validation_split_is_a_seeded_partition_with_a_tenth_held_out(n, seed):
+    tr, val = validation_split(n, seed)
+    assert len(val) == max(n // 10, 1)
+    assert sorted(np.concatenate([tr, val])) == list(range(n))
+    np.testing.assert_array_equal(validation_split(n, seed)[1], val)
+
+
+@pytest.mark.parametrize(
+    ("changes", "field"),
+    [
+        ({"batch": 0}, "batch"),
+        ({"epochs": 0}, "epochs"),
+        ({"patience": 0}, "patience"),
+        ({"batch": True}, "batch"),
+        ({"seed": -1}, "seed"),
+        ({"lr": float("nan")}, "lr"),
+        ({"lr": -1.0}, "lr"),
+        ({"time_budget": 0.0}, "time_budget"),
+        ({"time_budget": float("inf")}, "time_budget"),
+        ({"device": "tpu"}, "device"),
+        ({"device": "cuda:7"}, "device"),
+    ],
+)
+def test_bad_schedules_name_the_field(changes, field):
+    with pytest.raises(InputError, match=rf"^{field}: "):
+        FitConfig(**changes)

@@ -1,0 +1,111 @@
+"""Training GraphDistNet (gdnplan.train.graphdistnet): resuming, fine-tuning, cards, settings."""
+
+import json
+import warnings
+
+import pytest
+import torch
+
+from gdnplan.errors import InputError
+from gdnplan.models.graphdistnet import GraphDistNetConfig
+from gdnplan.train import (
+    FitConfig,
+    GraphDistNetLoss,
+    TrainConfig,
+    card_settings,
+    split_config,
+    train,
+)
+
+
+@pytest.fixture
+def tiny_data(tmp_path):
+    """60 training and 20 test samples of environment (a) under ``tmp_path``."""
+    from gdnplan.data import generate, split_dir
+
+    for split, n, seed in (("train", 60, 0), ("test", 20, 1)):
+        generate("a", n, seed, split_dir("a", split, tmp_path), workers=1)
+    return tmp_path
+
+
+def test_interrupted_training_resumes_to_the_same_weights(tiny_data):
+    """Two epochs in one go equal one epoch, then a resumed run to two epochs (the checkpoint
+    holds weights, Adam's moments, the best state and the log)."""
+    from safetensors.torch import load_file
+
+    tmp_path = tiny_data
+    network, loss = GraphDistNetConfig.smooth().with_(layers=1), GraphDistNetLoss(grad_weight=0.1)
+
+    def run(name: str, epochs: int) -> dict:
+        config = TrainConfig(network, loss, FitConfig(epochs=epochs, batch=16))
+        return train("a", config, data_root=tmp_path, out=tmp_path / f"{name}.safetensors",
+                     run_dir=tmp_path / name)  # fmt: skip
+
+    straight = run("straight", 2)
+    run("resumed", 1)
+    resumed = run("resumed", 2)
+    log = json.loads((tmp_path / "resumed" / "checkpoint.json").read_text())["log"]
+    assert [e["epoch"] for e in log] == [0, 1]
+    a, b = load_file(tmp_path / "straight.safetensors"), load_file(tmp_path / "resumed.safetensors")
+    assert set(a) == set(b) and all(torch.equal(a[k], b[k]) for k in a)
+    untimed = [
+        {k: v for k, v in c["test"].items() if "second" not in k} for c in (resumed, straight)
+    ]
+    assert untimed[0] == untimed[1]
+
+
+def test_fine_tuning_keeps_the_starting_weights_when_no_epoch_beats_them(tiny_data):
+    """A learning rate that wrecks the network: the starting weights win the validation."""
+    from safetensors.torch import load_file
+
+    network = GraphDistNetConfig.smooth().with_(layers=1)
+    start, tuned = tiny_data / "start.safetensors", tiny_data / "tuned.safetensors"
+    first = TrainConfig(network, fit=FitConfig(epochs=1))
+    train("a", first, data_root=tiny_data, out=start, run_dir=tiny_data / "r1")
+    tune = TrainConfig(network, fit=FitConfig(epochs=2, lr=50.0), init=start)
+    card = train("a", tune, data_root=tiny_data, out=tuned, run_dir=tiny_data / "r2")
+    log = json.loads((tiny_data / "r2" / "checkpoint.json").read_text())["log"]
+    assert len(log) == 2 and all(e["val_score"] > card["init"]["val_score"] for e in log)
+    a, b = load_file(start), load_file(tuned)
+    assert all(torch.equal(a[k], b[k]) for k in a)
+
+
+def test_cards_record_the_loss_apart_and_old_flat_cards_still_give_it(tiny_data):
+    """A new card: ``config`` is the architecture, ``training.loss`` the loss; --init of it
+    gives both back. An old flat card (loss weights in ``config``) gives the same split."""
+    from gdnplan.assets import weights_file
+
+    network = GraphDistNetConfig.smooth().with_(layers=1)
+    loss = GraphDistNetLoss(grad_weight=0.1, contact_weight=3.0)
+    out = tiny_data / "w.safetensors"
+    train("a", TrainConfig(network, loss, FitConfig(epochs=1)), data_root=tiny_data, out=out,
+          run_dir=tiny_data / "r")  # fmt: skip
+    card = json.loads(out.with_suffix(".json").read_text())
+    assert "grad_weight" not in card["config"] and card["training"]["loss"] == loss.to_dict()
+    got_network, got_loss = split_config(card_settings(out))
+    assert got_loss == loss and got_network.layers == 1
+    old = json.loads(weights_file("c").with_suffix(".json").read_text())  # a flat shipped card
+    old_network, old_loss = split_config(card_settings(weights_file("c")))
+    assert old_loss.grad_weight == old["config"]["grad_weight"] == 0.1
+    assert old_network == GraphDistNetConfig.from_dict(old["config"])
+
+
+def test_the_old_call_still_trains_with_a_deprecation_warning(tiny_data):
+    network = GraphDistNetConfig.smooth().with_(layers=1)
+    with pytest.warns(DeprecationWarning, match="TrainConfig"):
+        card = train("a", network, epochs=1, batch=16, data_root=tiny_data,
+                     out=tiny_data / "old.safetensors", run_dir=tiny_data / "old")  # fmt: skip
+    assert card["training"]["batch"] == 16 and card["training"]["epochs"] == 1
+    with warnings.catch_warnings(), pytest.raises(TypeError, match="unexpected"):
+        warnings.simplefilter("ignore")
+        train("a", network, batches=16)
+
+
+@pytest.mark.parametrize(
+    ("changes", "field"),
+    [({"n_train": 1}, "n_train"), ({"n_train": 2.5}, "n_train"),
+     ({"compile": True, "loss": GraphDistNetLoss(grad_weight=0.1)}, "compile")],
+)  # fmt: skip
+def test_bad_train_configs_name_the_field(changes, field):
+    with pytest.raises(InputError, match=rf"^{field}: "):
+        TrainConfig(**changes)
