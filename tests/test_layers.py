@@ -34,9 +34,19 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "planar",
             "robot_file",
             "scene",
+            "ur5e.kinematics",  # the UR5e/UR5 robot model: core robot modelling
+            "ur5e.gripper",
+            "ur5e.urdf",
+            "ur5e.arms",
+            "ur5e.ik",
+            "ur5e.layout",  # fetch layouts: plane polygons and tcp targets, no distances
         ),
     ),
-    ("exact geometry and seeds", ("distance", "ccd", "ccd_curve", "rrt", "ur5e")),
+    (
+        "exact geometry and seeds",
+        # ur5e (the package) re-exports the fetch scene, which keeps coal-clear poses
+        ("distance", "ccd", "ccd_curve", "rrt", "ur5e", "ur5e.scene", "ur5e.plot"),
+    ),
     ("graphs", ("graph",)),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
