@@ -31,6 +31,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "registry",
             "robot",
             "urdf_robot",
+            "urdf_robot.*",
             "planar",
             "robot_file",
             "scene",
