@@ -53,7 +53,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("casadi bridge", ("casadi_bridge",)),
     ("trajopt", ("trajopt", "trajopt.*", "timing")),
     ("training", ("data", "metrics", "train", "train_clearancenet")),
-    ("paper reproduction", ("evaluate", "table2", "fetch", "viz", "viz3d")),
+    ("paper reproduction", ("evaluate", "table2", "fetch", "viz", "viz3d", "viz3d.*")),
     ("cli", ("cli", "__init__")),
 ]
 
