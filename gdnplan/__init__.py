@@ -32,11 +32,11 @@ ROBOTS.declare(
     {
         "planar2": "gdnplan.planar",
         "planar7": "gdnplan.planar",
-        "ur5e": "gdnplan.ur5e",
-        "ur5": "gdnplan.ur5e",
+        "ur5e": "gdnplan.ur5e.arms",
+        "ur5": "gdnplan.ur5e.arms",
     }
 )
-SCENES.declare({"fetch": "gdnplan.ur5e"})
+SCENES.declare({"fetch": "gdnplan.ur5e.scene"})
 
 if TYPE_CHECKING:  # what the lazy names are, for type checkers and IDEs
     from .casadi_bridge import DistanceCallback

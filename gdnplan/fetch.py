@@ -39,7 +39,7 @@ from .models import DistanceModel
 from .scene import Scene, make_scene
 from .timing import time_path, urdf_velocity
 from .trajopt import Plan, Problem, TrajoptOptions, plan, resolve_model
-from .ur5e import LIFT, solve_ik
+from .ur5e import LIFT, analytic_ik
 
 log = logging.getLogger(__name__)  # one INFO line per finished stage
 
@@ -125,13 +125,13 @@ def lift_path(scene: Scene, n: int = LIFT_POINTS) -> np.ndarray:
     """(n, 3) IK path of the tcp from the grasp straight up by LIFT, nearest branch to q_grasp.
 
     Points p_k = grasp + (0, k · LIFT / (n − 1), 0), k = 0 … n − 1; each solved with
-    :func:`gdnplan.ur5e.solve_ik` and the solution nearest the previous configuration kept.
+    :func:`gdnplan.ur5e.analytic_ik` and the solution nearest the previous configuration kept.
     """
     grasp = scene.info["layout"].grasp_target()
     path = [scene.info["q_grasp"]]
     for k in range(1, n):
         target = grasp + np.array([0.0, k * LIFT / (n - 1), 0.0])
-        candidates = solve_ik(scene.robot, target)
+        candidates = analytic_ik(scene.robot, target)
         if not candidates:
             raise InfeasibleProblemError(f"lift: no IK solution {k * LIFT / (n - 1):.3f} m up")
         path.append(min(candidates, key=lambda q: float(np.abs(q - path[-1]).sum())))

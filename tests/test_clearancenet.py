@@ -1,8 +1,6 @@
 """ClearanceNet: input layout, autograd gradients (its training: test_train_clearancenet.py)."""
 
 import numpy as np
-import pytest
-import torch
 
 import gdnplan as gp
 from gdnplan.data import pad_polygons
@@ -27,23 +25,3 @@ def test_vertex_vector_layout_for_alpha_shapes():
     assert v.shape == (1, 5 * 15 * 2)
     first = scene.obstacles[0]
     np.testing.assert_allclose(v[0, : 2 * len(first)], first.ravel())
-
-
-@pytest.mark.parametrize("env", ["b", "d"])
-def test_gradient_matches_finite_differences(env):
-    torch.manual_seed(0)
-    config = cn.ClearanceNetConfig.for_env(env, hidden=(32, 32))
-    model = cn.ClearanceNetModel(cn.ClearanceNet(config).double())
-    scene = gp.make_scene(env, seed=4)
-    q = scene.robot.sample(10, seed=1)
-    d, g = model.distance_and_grad(scene, q)
-    h = 1e-6
-    fd = np.stack(
-        [
-            (model.distance(scene, q + h * e) - model.distance(scene, q - h * e)) / (2 * h)
-            for e in np.eye(q.shape[1])
-        ],
-        1,
-    )
-    np.testing.assert_allclose(g, fd, atol=1e-6)
-    np.testing.assert_allclose(d, model.distance(scene, q))

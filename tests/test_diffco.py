@@ -8,39 +8,9 @@ from gdnplan.evaluate import roc_auc
 from gdnplan.models.diffco import DiffCo, fastron
 
 
-def central_differences(model, scene, q, h=1e-6):
-    eye = np.eye(q.shape[1])
-    return np.stack(
-        [
-            (model.distance(scene, q + h * e) - model.distance(scene, q - h * e)) / (2 * h)
-            for e in eye
-        ],
-        1,
-    )
-
-
 @pytest.fixture(scope="module")
 def model_a():
     return DiffCo.train(gp.make_scene("a"), n=1500, seed=0)
-
-
-@pytest.mark.parametrize("fitted", [False, True])
-def test_gradient_matches_finite_differences(model_a, fitted):
-    model = model_a.fitted() if fitted else model_a
-    scene = gp.make_scene("a")
-    q = scene.robot.sample(20, seed=4)
-    d, g = model.distance_and_grad(scene, q)
-    np.testing.assert_allclose(d, model.distance(scene, q))
-    np.testing.assert_allclose(g, central_differences(model, scene, q), atol=1e-5 * np.abs(g).max())
-
-
-def test_gradient_7dof_matches_finite_differences():
-    scene = gp.make_scene("c")
-    model = DiffCo.train(scene, n=600, seed=1)
-    q = scene.robot.sample(10, seed=2)
-    for m in (model, model.fitted()):
-        _, g = m.distance_and_grad(scene, q)
-        np.testing.assert_allclose(g, central_differences(m, scene, q), atol=1e-5 * np.abs(g).max())
 
 
 def test_fastron_separates_training_points():

@@ -104,7 +104,7 @@ def test_fetch_errors():
 
 
 def test_fetch_gives_up_after_max_tries(monkeypatch):
-    monkeypatch.setattr(U, "fetch_configurations", lambda layout: None)  # no layout is free
+    monkeypatch.setattr(U.scene, "fetch_configurations", lambda layout: None)  # no layout is free
     with pytest.raises(gp.InfeasibleProblemError, match="max_tries=2"):
         gp.make_scene("fetch", seed=5, max_tries=2)
 

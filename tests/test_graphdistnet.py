@@ -48,34 +48,6 @@ def random_model(
     return scene, GraphDistNetModel(net, dtype=dtype)
 
 
-@pytest.mark.parametrize(
-    "changes",
-    [
-        {},
-        {"cross_k": 2},
-        {"two_way": False},
-        {"node_distance": True},
-        {"node_distance": True, "two_way": False, "min_readout": True},
-        {"node_distance": True, "min_readout": True, "tau_min": 0.02},
-        {"node_distance": True, "min_readout": True, "correction_band": 0.3, "probe_split": 3},
-    ],
-)
-def test_autograd_gradient_matches_finite_differences(changes):
-    scene, model = random_model("e", torch.float64, **changes)
-    q = scene.robot.sample(2, seed=2)
-    d, g = model.distance_and_grad(scene, q)
-    eps = 1e-6
-    fd = np.stack(
-        [
-            (model.distance(scene, q + eps * e) - model.distance(scene, q - eps * e)) / (2 * eps)
-            for e in np.eye(scene.robot.dof)
-        ],
-        1,
-    )
-    np.testing.assert_allclose(g, fd, atol=1e-8 * max(1.0, np.abs(g).max()), rtol=1e-5)
-    np.testing.assert_allclose(d, model.distance(scene, q))
-
-
 def test_batch_equals_per_sample_and_is_deterministic():
     scene, model = random_model("d")
     q = scene.robot.sample(6, seed=3)

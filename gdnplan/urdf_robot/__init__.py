@@ -1,0 +1,44 @@
+"""Robots from URDF files: a Pinocchio model reduced to its planning joints, link geometry
+projected onto the planning plane.
+
+A :class:`RobotSpec` names the URDF, the planning joints (a serial chain, base to tip), the
+values of every other joint and the plane's axes u, v (orthonormal world directions, normal
+n = u × v). Every other joint is locked, and at q = 0 each planning joint must turn about
+±n: then every robot point moves parallel to the plane and its plane coordinates
+
+    x ↦ (u · (x − o₁), v · (x − o₁)),     o₁ = planning joint 1's world position at q = 0,
+
+move by the plane rotations of :class:`~gdnplan.robot.PlanarChain`. A collision geometry
+becomes one link polygon: the convex hull of its surface points (box corners, rings of
+cylinders and spheres, mesh vertices) in plane coordinates, simplified to at most
+``max_vertices`` vertices by dropping the vertex whose removal loses the least area.
+Hand-made polygons (plane coordinates at q = 0) can replace or extend the projected ones.
+
+Modules: :mod:`~gdnplan.urdf_robot.spec` (:class:`RobotSpec`), :mod:`~gdnplan.urdf_robot.build`
+(the robot from a URDF or from built models), :mod:`~gdnplan.urdf_robot.checks` (plane axes,
+planning joints, locked values), :mod:`~gdnplan.urdf_robot.load` (URDF parsing with readable
+errors) and :mod:`~gdnplan.urdf_robot.shapes` (collision shapes → projected link polygons).
+Every public name is re-exported here.
+"""
+
+from __future__ import annotations
+
+from .build import robot_from_models, robot_from_urdf
+from .checks import AXIS_TOLERANCE, CONTINUOUS, JOINT_KINDS, PLANE_TOLERANCE, REVOLUTE, plane_basis
+from .load import load_urdf
+from .shapes import geometry_points
+from .spec import RobotSpec
+
+__all__ = [
+    "AXIS_TOLERANCE",
+    "CONTINUOUS",
+    "JOINT_KINDS",
+    "PLANE_TOLERANCE",
+    "REVOLUTE",
+    "RobotSpec",
+    "geometry_points",
+    "load_urdf",
+    "plane_basis",
+    "robot_from_models",
+    "robot_from_urdf",
+]

@@ -1,0 +1,85 @@
+"""Reading a URDF into Pinocchio, with the parser's complaint as a one-line InputError."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+import xml.etree.ElementTree as ET
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import InputError, UnknownNameError
+from .spec import RobotSpec
+
+
+def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
+    """Pinocchio model and collision geometry of ``spec.urdf``.
+
+    Continuous planning joints become revolute joints limited to [−π, π] (Pinocchio gives a
+    continuous joint two coordinates, cos θ and sin θ). UnknownNameError for a missing file;
+    InputError for one that does not parse, with the parser's first complaint.
+    """
+    path = Path(spec.urdf)
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):  # a name too long, a NUL byte
+        found = False
+    if not found:
+        raise UnknownNameError(f"urdf: file {path} does not exist (or is not a file)")
+    try:
+        root = ET.fromstring(path.read_bytes())
+    except (OSError, ET.ParseError) as e:
+        reason = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
+    rewritten = False
+    for joint in root.iter("joint"):
+        if joint.get("type") == "continuous" and joint.get("name") in spec.planning_joints:
+            joint.set("type", "revolute")
+            limit = joint.find("limit")
+            if limit is None:
+                limit = ET.SubElement(joint, "limit", effort="0", velocity="0")
+            limit.set("lower", repr(-np.pi))
+            limit.set("upper", repr(np.pi))
+            rewritten = True
+    packages = [str(p) for p in spec.package_dirs] + [str(p) for p in path.resolve().parents]
+    with _stderr_captured() as log:
+        try:
+            if rewritten:
+                text = ET.tostring(root, encoding="unicode")
+                model = pin.buildModelFromXML(text)
+                geom = pin.buildGeomFromUrdfString(
+                    model, text, pin.GeometryType.COLLISION, package_dirs=packages
+                )
+            else:
+                model = pin.buildModelFromUrdf(str(path))
+                geom = pin.buildGeomFromUrdf(
+                    model, str(path), pin.GeometryType.COLLISION, package_dirs=packages
+                )
+        except (ValueError, RuntimeError) as e:
+            error = e
+        else:
+            return model, geom
+    reason = next((line.strip() for line in log if line.strip().startswith("Error:")), "")
+    reason = (reason.removeprefix("Error:").strip() or str(error) or "no reason given").strip()
+    reason = reason.splitlines()[0]
+    raise InputError(f"urdf: {path} is not a valid URDF: {reason}") from error
+
+
+@contextlib.contextmanager
+def _stderr_captured() -> Iterator[list[str]]:
+    """Collect what C++ code (urdfdom) writes to file descriptor 2 into a list of lines."""
+    lines: list[str] = []
+    saved = os.dup(2)
+    with tempfile.TemporaryFile(mode="w+") as tmp:
+        os.dup2(tmp.fileno(), 2)
+        try:
+            yield lines
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            lines.extend(tmp.read().splitlines())
