@@ -32,14 +32,14 @@ PANDA_JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
 
 
 def _example_robot_data(name: str) -> tuple[Path, Path, Path]:
-    """(urdf, srdf, package dir) of an example-robot-data robot."""
+    """(urdf, srdf, the folder holding the ``example-robot-data`` package) of a robot."""
     try:
         from example_robot_data.robots_loader import ROBOTS
     except ImportError as e:  # pragma: no cover - a dependency of the install
         raise InputError(f"robot: {name!r} needs example-robot-data (pip install it)") from e
     loader = ROBOTS[name]()
     urdf = Path(loader.df_path).resolve()
-    return urdf, Path(loader.srdf_path).resolve(), Path(loader.model_path).resolve().parent
+    return urdf, Path(loader.srdf_path).resolve(), Path(loader.model_path).resolve().parent.parent
 
 
 def ur5e3d(finger: float = 0.02) -> Robot3D:
