@@ -43,7 +43,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ),
     (
         "exact geometry and seeds",
-        ("distance", "ccd", "ccd_curve", "rrt", "ur5e", "arm3d", "arm3d.distance3d"),
+        ("distance", "ccd", "ccd_curve", "rrt", "ur5e", "arm3d", "arm3d.distance3d", "arm3d.ccd3d"),
     ),
     ("graphs", ("graph",)),
     ("models", ("models", "models.*")),

@@ -6,11 +6,13 @@ distance with self-collision and its gradient.
   the UR5e, Panda and UR5; :mod:`gdnplan.arm3d.pairs`: self-collision pairs (SRDF).
 * :mod:`gdnplan.arm3d.scene3d`: obstacles and :class:`Scene3D`.
 * :mod:`gdnplan.arm3d.distance3d`: signed distance, gradient, broad phase.
+* :mod:`gdnplan.arm3d.ccd3d`: the continuous certificate of joint paths.
 """
 
 from __future__ import annotations
 
 from .builtin import load_robot3d, robot3d_names
+from .ccd3d import certify_path3d, lever_arms3d, motion_bound3d
 from .distance3d import (
     Checker3D,
     Coal3DModel,
@@ -43,11 +45,14 @@ __all__ = [
     "Scene3D",
     "box_obstacle",
     "capsule_obstacle",
+    "certify_path3d",
     "checker3d",
     "convex_obstacle",
     "cylinder_obstacle",
+    "lever_arms3d",
     "load_robot3d",
     "mesh_obstacle",
+    "motion_bound3d",
     "obstacle",
     "random_boxes",
     "robot3d_from_urdf",
