@@ -75,9 +75,12 @@ def rows(args: argparse.Namespace) -> list[str]:
         q = robot.random_configurations(args.n, np.random.default_rng(args.seed))
         colliding = float(np.mean(checker.evaluate(q).distance < 0))
         for broad in (True, False):
-            t_d, res = best(lambda b=broad: checker.evaluate(q, broad_phase=b), args.repeats)
+            t_d, res = best(
+                lambda b=broad, c=checker, q=q: c.evaluate(q, broad_phase=b), args.repeats
+            )
             t_g, _ = best(
-                lambda b=broad: checker.evaluate(q, broad_phase=b, gradient=True), args.repeats
+                lambda b=broad, c=checker, q=q: c.evaluate(q, broad_phase=b, gradient=True),
+                args.repeats,
             )
             out.append(
                 f"| {name} | {len(robot.shapes)} | {checker.n_pairs} "
