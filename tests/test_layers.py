@@ -41,19 +41,38 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ur5e.arms",
             "ur5e.ik",
             "ur5e.layout",  # fetch layouts: plane polygons and tcp targets, no distances
+            "arm3d.shapes",
+            "arm3d.pairs",
+            "arm3d.robot3d",
+            "arm3d.builtin",
+            "arm3d.scene3d",
         ),
     ),
     (
         "exact geometry and seeds",
         # ur5e (the package) re-exports the fetch scene, which keeps coal-clear poses
-        ("distance", "ccd", "ccd_curve", "rrt", "ur5e", "ur5e.scene", "ur5e.plot"),
+        (
+            "distance",
+            "ccd",
+            "ccd_curve",
+            "rrt",
+            "ur5e",
+            "ur5e.scene",
+            "ur5e.plot",
+            "arm3d",
+            "arm3d.distance3d",
+            "arm3d.ccd3d",
+        ),
     ),
     ("graphs", ("graph",)),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
     ("trajopt", ("trajopt", "trajopt.*", "timing")),
     ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
-    ("paper reproduction", ("env_models", "evaluate", "table2", "fetch", "viz", "viz3d", "viz3d.*")),
+    (
+        "paper reproduction",
+        ("env_models", "evaluate", "table2", "fetch", "viz", "viz3d", "viz3d.*"),
+    ),
     ("cli", ("cli", "__init__")),
 ]
 

@@ -1,0 +1,63 @@
+"""3-D arms: robots from URDF through Pinocchio, posed convex obstacles, exact coal signed
+distance with self-collision and its gradient.
+
+* :mod:`gdnplan.arm3d.shapes`: validated coal shapes (primitives, hulls, meshes) and poses.
+* :mod:`gdnplan.arm3d.robot3d`: :class:`Robot3D` from any URDF; :mod:`gdnplan.arm3d.builtin`:
+  the UR5e, Panda and UR5; :mod:`gdnplan.arm3d.pairs`: self-collision pairs (SRDF).
+* :mod:`gdnplan.arm3d.scene3d`: obstacles and :class:`Scene3D`.
+* :mod:`gdnplan.arm3d.distance3d`: signed distance, gradient, broad phase.
+* :mod:`gdnplan.arm3d.ccd3d`: the continuous certificate of joint paths.
+"""
+
+from __future__ import annotations
+
+from .builtin import load_robot3d, robot3d_names
+from .ccd3d import certify_path3d, lever_arms3d, motion_bound3d
+from .distance3d import (
+    Checker3D,
+    Coal3DModel,
+    Distances3D,
+    checker3d,
+    signed_distance3d,
+    signed_distance3d_and_grad,
+)
+from .robot3d import LinkShape, Robot3D, robot3d_from_urdf
+from .scene3d import (
+    Obstacle3D,
+    Scene3D,
+    box_obstacle,
+    capsule_obstacle,
+    convex_obstacle,
+    cylinder_obstacle,
+    mesh_obstacle,
+    obstacle,
+    random_boxes,
+    sphere_obstacle,
+)
+
+__all__ = [
+    "Checker3D",
+    "Coal3DModel",
+    "Distances3D",
+    "LinkShape",
+    "Obstacle3D",
+    "Robot3D",
+    "Scene3D",
+    "box_obstacle",
+    "capsule_obstacle",
+    "certify_path3d",
+    "checker3d",
+    "convex_obstacle",
+    "cylinder_obstacle",
+    "lever_arms3d",
+    "load_robot3d",
+    "mesh_obstacle",
+    "motion_bound3d",
+    "obstacle",
+    "random_boxes",
+    "robot3d_from_urdf",
+    "robot3d_names",
+    "signed_distance3d",
+    "signed_distance3d_and_grad",
+    "sphere_obstacle",
+]

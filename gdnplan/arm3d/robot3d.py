@@ -1,0 +1,270 @@
+"""3-D robots from URDF files through Pinocchio: planning joints, coal link shapes, kinematics.
+
+A :class:`Robot3D` is a Pinocchio model reduced to its planning joints (every other joint is
+locked at a value) and the link collision geometry as coal shapes: URDF primitives stay coal
+primitives (box, sphere, cylinder, capsule), meshes become their convex hulls
+(:func:`gdnplan.arm3d.shapes.mesh_hull`: validated, a non-convex mesh logs a note). A shape
+belongs to the URDF link that carries it and moves with that link's *body*: the planning joint
+the link hangs from (0 = the fixed base). Configurations q are (n,) or (B, n) in radians, in the
+reduced model's joint order (:attr:`Robot3D.joint_names`); continuous joints are planned within
+[−π, π].
+
+Kinematics (one configuration): the world placement of shape s is oMᵢ(q) · Mₛ with i its body
+and Mₛ the fixed placement of the shape in the body's joint frame. The linear velocity of a
+point p fixed on body i is v = Σ_j (J_v,j + ω_j × (p − oᵢ)) q̇_j, from Pinocchio's joint
+Jacobian J = [J_v; J_ω] (6, n) of body i in the LOCAL_WORLD_ALIGNED frame (origin at the joint
+oᵢ, world axes); :meth:`Robot3D.point_jacobian` returns J_p = J_v − [p − oᵢ]× J_ω (3, n).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from ..errors import InputError, UnknownNameError
+from ..robot import as_batch
+from ..urdf_robot import RobotSpec, load_urdf
+from .pairs import self_collision_pairs
+from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
+
+
+@dataclass(frozen=True)
+class LinkShape:
+    """One collision shape of a robot link.
+
+    Attributes:
+        name: the geometry's name (Pinocchio's geometry object name).
+        link: the URDF link carrying it.
+        body: the joint index (reduced model) the link moves with; 0 = fixed base.
+        shape: the coal shape, in its own frame.
+        placement: (4, 4) homogeneous placement of the shape frame in the body's joint frame.
+        center: (3,) bounding-sphere centre in the shape frame (m); radius: its radius (m).
+    """
+
+    name: str
+    link: str
+    body: int
+    shape: coal.CollisionGeometry
+    placement: np.ndarray
+    center: np.ndarray
+    radius: float
+
+
+class Robot3D:
+    """A 3-D arm: a reduced Pinocchio model, coal link shapes and self-collision pairs.
+
+    Attributes:
+        name: the robot's name. model: the reduced ``pin.Model`` (nq = nv = dof).
+        shapes: every link shape; links: names of the links with shapes (the per-link order).
+        shape_link: (S,) index into ``links`` of each shape.
+        self_pairs: (P, 2) shape indices of the self-collision pairs checked.
+        lower, upper: (dof,) joint limits (rad).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        model: pin.Model,
+        shapes: Sequence[LinkShape],
+        self_pairs: np.ndarray,
+        disabled: dict[frozenset[str], str],
+        info: dict | None = None,
+    ):
+        self.name = name
+        self.model = model
+        self.data = model.createData()
+        self.shapes = tuple(shapes)
+        self.links = tuple(dict.fromkeys(s.link for s in self.shapes))
+        self.shape_link = np.array([self.links.index(s.link) for s in self.shapes], dtype=int)
+        self.shape_body = np.array([s.body for s in self.shapes], dtype=int)
+        self.self_pairs = np.asarray(self_pairs, dtype=int).reshape(-1, 2)
+        self.disabled = dict(disabled)
+        self.lower = model.lowerPositionLimit.copy()
+        self.upper = model.upperPositionLimit.copy()
+        self.info = dict(info or {})
+        self.joint_names = tuple(model.names[1:])
+
+    @property
+    def dof(self) -> int:
+        return int(self.model.nq)
+
+    @property
+    def n_links(self) -> int:
+        return len(self.links)
+
+    def check_q(self, q, name: str = "q") -> np.ndarray:
+        """Joint angles as float64 (B, dof); InputError for a wrong shape, NaN or infinity."""
+        return as_batch(q, self.dof, name)
+
+    def within_limits(self, q, tol: float = 1e-9) -> np.ndarray:
+        """(B,) True where every joint is within its limits."""
+        q = self.check_q(q)
+        return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=1)
+
+    def random_configurations(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """(n, dof) configurations drawn uniformly within the joint limits."""
+        return rng.uniform(self.lower, self.upper, size=(n, self.dof))
+
+    # ---------------------------------------------------------------- kinematics
+    def body_placements(self, q: np.ndarray) -> np.ndarray:
+        """(njoints, 4, 4) world placements of every body's joint frame at one q (dof,)."""
+        pin.forwardKinematics(self.model, self.data, np.asarray(q, dtype=float))
+        return np.array([m.homogeneous for m in self.data.oMi])
+
+    def shape_placements(self, q: np.ndarray) -> np.ndarray:
+        """(S, 4, 4) world placements of every link shape at one configuration q (dof,)."""
+        bodies = self.body_placements(q)
+        local = np.array([s.placement for s in self.shapes]).reshape(-1, 4, 4)
+        return bodies[self.shape_body] @ local
+
+    def joint_jacobians(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every body's joint Jacobian (njoints, 6, dof), LOCAL_WORLD_ALIGNED ([v; ω] of the
+        joint origin in world axes), and the joint origins (njoints, 3) in m, at one q (dof,)."""
+        q = np.asarray(q, dtype=float)
+        pin.computeJointJacobians(self.model, self.data, q)
+        frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        jac = np.array(
+            [
+                pin.getJointJacobian(self.model, self.data, j, frame)
+                for j in range(self.model.njoints)
+            ]
+        )
+        origins = np.array([m.translation for m in self.data.oMi])
+        return jac, origins
+
+    def point_jacobian(self, q: np.ndarray, body: int, point: np.ndarray) -> np.ndarray:
+        """(3, dof) Jacobian ∂p/∂q of a world point (3,) fixed on ``body`` at one q (dof,)."""
+        jac, origins = self.joint_jacobians(q)
+        return point_jacobians(jac[body][None], origins[body][None], np.asarray(point)[None])[0]
+
+
+def point_jacobians(jac: np.ndarray, origins: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(k, 3, dof) point Jacobians J_v − [p − o]× J_ω from joint Jacobians (k, 6, dof), their
+    origins (k, 3) and points (k, 3) on those bodies (world frame, m)."""
+    r = points - origins
+    jv, jw = jac[:, :3], jac[:, 3:]
+    return jv + np.cross(jw, r[:, :, None], axisa=1, axisb=1, axisc=1)
+
+
+# -------------------------------------------------------------------- loading
+def robot3d_from_urdf(
+    urdf: str | Path,
+    package_dirs: Sequence[str | Path] = (),
+    joints: Sequence[str] | None = None,
+    locked: dict[str, float] | None = None,
+    srdf: str | Path | None = None,
+    name: str | None = None,
+) -> Robot3D:
+    """A 3-D robot from a URDF file (and optionally its SRDF for disabled collision pairs).
+
+    Args:
+        urdf: the URDF path; ``package://`` meshes resolve against ``package_dirs`` and the
+            URDF's parent folders.
+        package_dirs: extra folders for ``package://`` paths.
+        joints: the planning joints (revolute or continuous), in the URDF's order; None: every
+            revolute and continuous joint.
+        locked: values (rad or m) of other joints; unlisted ones lock at 0 clipped into their
+            limits.
+        srdf: an SRDF whose ``disable_collisions`` pairs are not checked for self-collision
+            (see :func:`gdnplan.arm3d.pairs.self_collision_pairs`).
+        name: the robot's name (default: the URDF's stem).
+
+    Raises:
+        UnknownNameError: a missing URDF, mesh, SRDF, or an unknown joint name.
+        InputError: a URDF that does not parse, invalid geometry (flat, NaN, huge), joints out
+            of order, a locked value outside its limits.
+    """
+    path = Path(urdf)
+    dirs = tuple(str(d) for d in package_dirs)
+    model, geom = load_urdf(
+        RobotSpec(urdf=path, planning_joints=tuple(joints or ()), package_dirs=dirs)
+    )
+    movable = [
+        model.names[j]
+        for j in range(1, model.njoints)
+        if model.joints[j].shortname().removeprefix("JointModel").startswith("R")
+        and model.joints[j].nv == 1  # revolute (RX, RY, RZ, RevoluteUnaligned) or continuous
+    ]
+    planning = list(joints) if joints is not None else movable
+    if joints is None and any(model.joints[model.getJointId(j)].nq == 2 for j in planning):
+        model, geom = load_urdf(RobotSpec(path, tuple(planning), package_dirs=dirs))
+    _check_joints(model, planning, movable, path.name)
+    q_ref = _locked_configuration(model, planning, locked or {}, path.name)
+    lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in planning]
+    reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
+    shapes = [_link_shape(reduced, obj) for obj in reduced_geom.geometryObjects]
+    if not shapes:
+        raise InputError(f"urdf: {path.name} has no collision geometry; add <collision> shapes")
+    pairs, disabled = self_collision_pairs(model, reduced, shapes, srdf)
+    return Robot3D(name or path.stem, reduced, shapes, pairs, disabled, {"urdf": str(path)})
+
+
+def _check_joints(model: pin.Model, planning: list[str], movable: list[str], source: str) -> None:
+    if not planning:
+        raise InputError(f"joints: {source} has no revolute joint to plan; list planning joints")
+    for jname in planning:
+        if jname not in movable:
+            if model.existJointName(jname):
+                raise InputError(
+                    f"joints: {jname!r} is not a revolute joint; lock it with a value instead"
+                )
+            raise UnknownNameError(
+                f"joints: {jname!r} is not a joint of {source}; its revolute joints: {movable}"
+            )
+    order = [j for j in movable if j in planning]
+    if len(set(planning)) != len(planning) or order != list(planning):
+        raise InputError(f"joints: list each planning joint once, in the URDF's order: {order}")
+
+
+def _locked_configuration(
+    model: pin.Model, planning: list[str], locked: dict, source: str
+) -> np.ndarray:
+    """The full model's q with every non-planning joint at its locked value."""
+    q = pin.neutral(model)
+    for j in range(1, model.njoints):
+        joint, jname = model.joints[j], model.names[j]
+        if jname in planning or joint.nq != 1:
+            continue
+        lo, hi = model.lowerPositionLimit[joint.idx_q], model.upperPositionLimit[joint.idx_q]
+        q[joint.idx_q] = float(np.clip(0.0, lo, hi))
+    for jname, value in locked.items():
+        if not isinstance(jname, str) or not model.existJointName(jname) or jname in planning:
+            raise UnknownNameError(f"locked: {jname!r} is not a non-planning joint of {source}")
+        joint = model.joints[model.getJointId(jname)]
+        lo, hi = model.lowerPositionLimit[joint.idx_q], model.upperPositionLimit[joint.idx_q]
+        if joint.nq != 1 or not np.isfinite(value) or not lo - 1e-9 <= value <= hi + 1e-9:
+            raise InputError(f"locked: {jname!r} = {value!r} is outside [{lo:.4g}, {hi:.4g}]")
+        q[joint.idx_q] = value
+    return q
+
+
+def _link_shape(model: pin.Model, obj: pin.GeometryObject) -> LinkShape:
+    """The validated coal shape of one geometry object (a mesh becomes its convex hull)."""
+    g, where = obj.geometry, f"geometry {obj.name!r}"
+    if isinstance(g, coal.Box):
+        shape = box(2 * np.asarray(g.halfSide), where)
+    elif isinstance(g, coal.Sphere):
+        shape = sphere(g.radius, where)
+    elif isinstance(g, coal.Capsule):
+        shape = capsule(g.radius, 2 * g.halfLength, where)
+    elif isinstance(g, coal.Cylinder):
+        shape = cylinder(g.radius, 2 * g.halfLength, where)
+    elif hasattr(g, "vertices") or hasattr(g, "points"):
+        shape = mesh_hull(bvh_vertices(g), where)
+    else:
+        raise InputError(f"{where}: unsupported collision shape {type(g).__name__}")
+    center, radius = bounding_sphere(shape)
+    return LinkShape(
+        name=obj.name,
+        link=model.frames[obj.parentFrame].name,
+        body=int(obj.parentJoint),
+        shape=shape,
+        placement=obj.placement.homogeneous.copy(),
+        center=center,
+        radius=radius,
+    )

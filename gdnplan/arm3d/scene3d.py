@@ -1,0 +1,144 @@
+"""3-D scenes: a :class:`~gdnplan.arm3d.robot3d.Robot3D` among posed convex obstacles.
+
+Obstacles are boxes, spheres, cylinders, capsules, convex hulls of points and convex hulls of
+mesh files (STL, OBJ, …), each with a world pose: a position (3,) in metres and a rotation as a
+quaternion (x, y, z, w) or a 3×3 rotation matrix (:func:`gdnplan.arm3d.shapes.as_pose`).
+Every number is validated before coal sees it. A TOML schema comes later; the Python API is::
+
+    scene = Scene3D(robot, [box_obstacle((0.2, 0.2, 0.4), (0.5, 0.0, 0.2)),
+                            sphere_obstacle(0.1, (0.3, 0.3, 0.5))])
+
+:func:`random_boxes` draws N axis-aligned boxes in the arm's workspace, clear of its base.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+
+from ..errors import InputError
+from ..limits import check_int, check_number
+from .robot3d import Robot3D
+from .shapes import as_pose, bounding_sphere, box, capsule, convex, cylinder, load_mesh, sphere
+
+MAX_OBSTACLES = 10_000
+
+
+@dataclass(frozen=True)
+class Obstacle3D:
+    """A convex obstacle: its coal shape and world placement.
+
+    Attributes:
+        name: for messages and reports. shape: the coal shape in its own frame.
+        pose: the shape frame's world placement (coal.Transform3s).
+        center: (3,) world centre of its bounding sphere (m); radius: that sphere's radius (m).
+    """
+
+    name: str
+    shape: coal.CollisionGeometry
+    pose: coal.Transform3s
+    center: np.ndarray
+    radius: float
+
+
+def obstacle(shape, position=(0.0, 0.0, 0.0), rotation=None, name: str = "obstacle"):
+    """An :class:`Obstacle3D` of a coal shape (built by :mod:`gdnplan.arm3d.shapes`) posed in
+    the world: ``position`` (3,) in m, ``rotation`` a quaternion (x, y, z, w) or a 3×3 matrix."""
+    pose = as_pose(position, rotation, name)
+    local_center, radius = bounding_sphere(shape)
+    center = np.asarray(pose.getRotation()) @ local_center + np.asarray(pose.getTranslation())
+    return Obstacle3D(name, shape, pose, center, radius)
+
+
+def box_obstacle(size, position, rotation=None, name: str = "box") -> Obstacle3D:
+    """A box of full sides ``size`` (3,) in m, centred at ``position``."""
+    return obstacle(box(size, name), position, rotation, name)
+
+
+def sphere_obstacle(radius, position, name: str = "sphere") -> Obstacle3D:
+    """A sphere of ``radius`` (m) centred at ``position``."""
+    return obstacle(sphere(radius, name), position, None, name)
+
+
+def cylinder_obstacle(radius, length, position, rotation=None, name="cylinder") -> Obstacle3D:
+    """A cylinder (axis = the rotated z axis), ``radius`` and full ``length`` in m."""
+    return obstacle(cylinder(radius, length, name), position, rotation, name)
+
+
+def capsule_obstacle(radius, length, position, rotation=None, name="capsule") -> Obstacle3D:
+    """A capsule (segment of full ``length`` along the rotated z axis, swept by ``radius``)."""
+    return obstacle(capsule(radius, length, name), position, rotation, name)
+
+
+def convex_obstacle(points, position=(0, 0, 0), rotation=None, name="convex") -> Obstacle3D:
+    """The convex hull of ``points`` (k, 3) given in the obstacle's frame (m)."""
+    return obstacle(convex(points, name), position, rotation, name)
+
+
+def mesh_obstacle(path, position=(0, 0, 0), rotation=None, scale=(1, 1, 1), name="mesh"):
+    """The convex hull of a mesh file (a non-convex mesh logs a note and uses its hull)."""
+    return obstacle(load_mesh(path, scale, name), position, rotation, name)
+
+
+class Scene3D:
+    """A 3-D robot and its obstacles (a sequence of :class:`Obstacle3D`)."""
+
+    def __init__(self, robot: Robot3D, obstacles: Sequence[Obstacle3D] = ()):
+        if not isinstance(robot, Robot3D):
+            raise InputError(f"robot: expected a Robot3D, got {type(robot).__name__}")
+        obstacles = tuple(obstacles)
+        if len(obstacles) > MAX_OBSTACLES:
+            raise InputError(f"obstacles: {len(obstacles)} given, the limit is {MAX_OBSTACLES}")
+        for k, o in enumerate(obstacles):
+            if not isinstance(o, Obstacle3D):
+                raise InputError(f"obstacles[{k}]: expected an Obstacle3D, got {type(o).__name__}")
+        self.robot = robot
+        self.obstacles = obstacles
+
+    def __repr__(self) -> str:
+        return f"Scene3D({self.robot.name}, {len(self.obstacles)} obstacles)"
+
+
+def workspace_radius(robot: Robot3D, samples: int = 256, seed: int = 0) -> float:
+    """Radius (m) around the base origin that encloses every link shape's bounding sphere at
+    ``samples`` random configurations (an estimate of the arm's reach)."""
+    rng = np.random.default_rng(seed)
+    centers = np.array([s.center for s in robot.shapes])
+    radii = np.array([s.radius for s in robot.shapes])
+    reach = 0.0
+    for q in robot.random_configurations(samples, rng):
+        tf = robot.shape_placements(q)
+        world = np.einsum("sij,sj->si", tf[:, :3, :3], centers) + tf[:, :3, 3]
+        reach = max(reach, float(np.max(np.linalg.norm(world, axis=1) + radii)))
+    return reach
+
+
+def random_boxes(
+    robot: Robot3D,
+    n: int = 20,
+    seed: int = 0,
+    size: tuple[float, float] = (0.05, 0.2),
+    base_clearance: float = 0.25,
+) -> Scene3D:
+    """N random axis-aligned boxes in the arm's workspace: centres uniform in the upper half
+    of the ball of radius :func:`workspace_radius` (z ≥ 0), sides uniform in ``size`` (m),
+    centres farther than ``base_clearance`` (m) from the base's vertical axis."""
+    check_int(n, "n", 0, MAX_OBSTACLES)
+    lo = check_number(size[0], "size[0]", 0.0, strict=True)
+    hi = check_number(size[1], "size[1]", lo)
+    clearance = check_number(base_clearance, "base_clearance")
+    reach = workspace_radius(robot)
+    if clearance >= reach:
+        raise InputError(f"base_clearance: {clearance} m leaves no room in reach {reach:.3g} m")
+    rng = np.random.default_rng(seed)
+    boxes: list[Obstacle3D] = []
+    while len(boxes) < n:
+        c = rng.uniform(-reach, reach, 3)
+        c[2] = abs(c[2])
+        if np.linalg.norm(c) > reach or np.linalg.norm(c[:2]) < clearance:
+            continue
+        boxes.append(box_obstacle(rng.uniform(lo, hi, 3), c, name=f"box{len(boxes)}"))
+    return Scene3D(robot, boxes)

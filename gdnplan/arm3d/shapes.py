@@ -1,0 +1,266 @@
+"""3-D collision shapes for coal: validated primitives, convex hulls of points and meshes, poses.
+
+Every shape reaches coal only after its numbers are checked, because coal's convex hull crashes
+the process (a segfault, no exception) on nearly flat point sets and huge coordinates:
+
+* coordinates and sizes are finite numbers with ``|x| ≤ MAX_COORDINATE`` (m);
+* primitive sizes (box sides, radii, lengths) are at least ``MIN_SIZE`` (m);
+* a point set's convex hull is computed first with scipy's Qhull (which raises instead of
+  crashing) and must be thick: its thickness t = 2 V / A (hull volume V, surface area A; exact
+  for a thin slab, 2 r / 3 for a ball of radius r) satisfies t ≥ MIN_SIZE and
+  t ≥ ``REL_THICKNESS`` · diameter. Only the hull's vertices go to coal.
+
+A mesh is always used as its convex hull. A mesh with a vertex deeper than ``CONVEX_TOLERANCE``
+(relative to its diameter) inside that hull is not convex; it is still replaced by its hull
+(a superset: distances to it are lower bounds of the mesh's), and a note is logged on the
+``gdnplan.arm3d`` logger. Mesh files are read with coal's own loader (assimp: STL, OBJ, DAE, …).
+
+Poses are a position (3,) in metres and a rotation given as a quaternion (x, y, z, w), any
+nonzero length (normalised), or a 3×3 rotation matrix (orthonormal within ``ROTATION_TOLERANCE``,
+determinant +1).
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import coal
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from ..errors import InputError, UnknownNameError
+from ..limits import is_number
+
+MAX_COORDINATE = 1e3  # m: largest |coordinate| of any point, position or size
+MIN_SIZE = 1e-6  # m: smallest primitive size and hull thickness
+REL_THICKNESS = 1e-4  # hull thickness / diameter floor (coal's hull crashed near 1e-8)
+MAX_HULL_POINTS = 100_000  # points of one convex hull (mesh vertices)
+CONVEX_TOLERANCE = 1e-6  # a mesh vertex deeper than this · diameter inside its hull: non-convex
+ROTATION_TOLERANCE = 1e-6  # largest |RᵀR − I| entry of a rotation matrix
+
+log = logging.getLogger("gdnplan.arm3d")
+
+
+# -------------------------------------------------------------------- numbers
+def as_vector(value, n: int, name: str) -> np.ndarray:
+    """A finite float (n,) array of numbers bounded by MAX_COORDINATE, else InputError."""
+    items = np.asarray(value, dtype=object)
+    if items.shape != (n,) or not all(is_number(x) for x in items.ravel()):
+        raise InputError(f"{name}: expected {n} numbers, got {value!r}")
+    out = items.astype(float)
+    if not np.all(np.isfinite(out)):
+        raise InputError(f"{name}: contains NaN or infinite values ({value!r})")
+    if np.max(np.abs(out)) > MAX_COORDINATE:
+        raise InputError(f"{name}: values beyond {MAX_COORDINATE:g} m; use metres near the robot")
+    return out
+
+
+def as_size(value, name: str) -> float:
+    """A primitive size (m) in [MIN_SIZE, MAX_COORDINATE], else InputError."""
+    if not is_number(value) or not np.isfinite(value) or not MIN_SIZE <= value <= MAX_COORDINATE:
+        raise InputError(
+            f"{name}: expected a size in [{MIN_SIZE:g}, {MAX_COORDINATE:g}] m, got {value!r}"
+        )
+    return float(value)
+
+
+def as_points(points, name: str) -> np.ndarray:
+    """A finite, bounded float (k, 3) point array (4 ≤ k ≤ MAX_HULL_POINTS), else InputError."""
+    try:
+        pts = np.asarray(points, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"{name}: expected points of shape (k, 3), got {type(points)}") from e
+    if pts.ndim != 2 or pts.shape[1] != 3 or not 4 <= len(pts) <= MAX_HULL_POINTS:
+        raise InputError(
+            f"{name}: expected (k, 3) points with 4 ≤ k ≤ {MAX_HULL_POINTS}, got {pts.shape}"
+        )
+    if not np.all(np.isfinite(pts)):
+        raise InputError(f"{name}: contains NaN or infinite coordinates")
+    if np.max(np.abs(pts)) > MAX_COORDINATE:
+        raise InputError(
+            f"{name}: coordinates beyond {MAX_COORDINATE:g} m; use metres near the robot"
+        )
+    return pts
+
+
+# -------------------------------------------------------------------- shapes
+def box(size, name: str = "box") -> coal.Box:
+    """A box of full side lengths (sx, sy, sz) in metres, centred on its frame."""
+    sides = [as_size(s, f"{name}.size") for s in as_vector(size, 3, f"{name}.size")]
+    return coal.Box(*sides)
+
+
+def sphere(radius, name: str = "sphere") -> coal.Sphere:
+    """A sphere of ``radius`` (m) centred on its frame."""
+    return coal.Sphere(as_size(radius, f"{name}.radius"))
+
+
+def cylinder(radius, length, name: str = "cylinder") -> coal.Cylinder:
+    """A cylinder along the frame's z axis: ``radius``, full ``length`` (m), centred."""
+    return coal.Cylinder(as_size(radius, f"{name}.radius"), as_size(length, f"{name}.length"))
+
+
+def capsule(radius, length, name: str = "capsule") -> coal.Capsule:
+    """A capsule along z: a segment of full ``length`` (m) swept by a ball of ``radius``."""
+    return coal.Capsule(as_size(radius, f"{name}.radius"), as_size(length, f"{name}.length"))
+
+
+def hull_vertices(points, name: str) -> tuple[np.ndarray, ConvexHull]:
+    """Vertices (h, 3) of the convex hull of ``points`` after the checks of the module."""
+    pts = as_points(points, name)
+    diameter = float(np.linalg.norm(pts.max(0) - pts.min(0)))
+    flat = f"{name}: the points are (nearly) flat or a line; give the shape thickness"
+    if diameter < MIN_SIZE:
+        raise InputError(f"{name}: the points span less than {MIN_SIZE:g} m")
+    try:
+        hull = ConvexHull(pts)
+    except (QhullError, ValueError) as e:
+        raise InputError(flat) from e
+    thickness = 2.0 * hull.volume / hull.area
+    if thickness < max(MIN_SIZE, REL_THICKNESS * diameter):
+        raise InputError(
+            f"{flat} (thickness 2·volume/area = {thickness:.3g} m < {REL_THICKNESS:g} · "
+            f"diameter {diameter:.3g} m)"
+        )
+    return pts[hull.vertices], hull
+
+
+def convex(points, name: str = "convex") -> coal.ConvexBase:
+    """The convex hull of ``points`` (k, 3) in metres as a coal convex shape."""
+    vertices, _ = hull_vertices(points, name)
+    return _coal_hull(vertices)
+
+
+def _coal_hull(vertices: np.ndarray) -> coal.ConvexBase:
+    cloud = coal.StdVec_Vec3s()
+    for p in vertices:
+        cloud.append(p)
+    return coal.ConvexBase.convexHull(cloud, False, "")
+
+
+def mesh_hull(vertices, name: str) -> coal.ConvexBase:
+    """The convex hull of a mesh's vertices (k, 3); logs a note when the mesh is not convex."""
+    pts = as_points(vertices, name)
+    hull_pts, hull = hull_vertices(pts, name)
+    depth = _deepest_inside(pts, hull)
+    if depth > CONVEX_TOLERANCE * float(np.linalg.norm(pts.max(0) - pts.min(0))):
+        log.info(
+            "%s: the mesh is not convex (a vertex lies %.3g m inside its hull); using its "
+            "convex hull",
+            name,
+            depth,
+        )
+    return _coal_hull(hull_pts)
+
+
+def is_convex_mesh(vertices) -> bool:
+    """True when no vertex lies deeper than CONVEX_TOLERANCE · diameter inside the hull."""
+    pts = as_points(vertices, "mesh")
+    _, hull = hull_vertices(pts, "mesh")
+    return _deepest_inside(pts, hull) <= CONVEX_TOLERANCE * float(
+        np.linalg.norm(pts.max(0) - pts.min(0))
+    )
+
+
+def _deepest_inside(pts: np.ndarray, hull: ConvexHull) -> float:
+    """Largest depth (m) of a point inside the hull: min over facets of −(n·p + b), n unit."""
+    offsets = hull.equations[:, :3] @ pts.T + hull.equations[:, 3:]  # (facets, k) ≤ 0 inside
+    return float(np.max(-np.max(offsets, axis=0)))
+
+
+def load_mesh(path, scale=(1.0, 1.0, 1.0), name: str = "mesh") -> coal.ConvexBase:
+    """The convex hull of the mesh file ``path`` (STL, OBJ, DAE, … via coal's assimp loader).
+
+    ``scale``: per-axis factors applied to the file's coordinates (a file in millimetres
+    needs 1e-3). UnknownNameError for a missing file, InputError for one that is not a mesh.
+    """
+    path = Path(path)
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):
+        found = False
+    if not found:
+        raise UnknownNameError(f"{name}: mesh file {path} does not exist (or is not a file)")
+    factors = np.asarray(scale, dtype=float)
+    if factors.shape != (3,) or not np.all(np.isfinite(factors)) or np.any(factors <= 0):
+        raise InputError(f"{name}.scale: expected three positive numbers, got {scale!r}")
+    try:
+        bvh = coal.MeshLoader().load(str(path), factors)
+    except (ValueError, RuntimeError) as e:
+        raise InputError(f"{name}: {path} is not a mesh file coal can read (STL, OBJ, DAE)") from e
+    return mesh_hull(bvh_vertices(bvh), f"{name} ({path.name})")
+
+
+def bvh_vertices(geometry) -> np.ndarray:
+    """Vertices (k, 3) of a coal BVH mesh (or the points of a convex shape)."""
+    if hasattr(geometry, "vertices"):
+        return np.asarray(geometry.vertices(), dtype=float)
+    return np.asarray(geometry.points(), dtype=float)
+
+
+# -------------------------------------------------------------------- poses
+def as_rotation(rotation, name: str = "rotation") -> np.ndarray:
+    """A 3×3 rotation matrix from a quaternion (x, y, z, w) or a matrix; None → identity."""
+    if rotation is None:
+        return np.eye(3)
+    items = np.asarray(rotation, dtype=object)
+    if items.shape == (4,):
+        quat = as_vector(rotation, 4, name)
+        norm = float(np.linalg.norm(quat))
+        if norm < 1e-9:
+            raise InputError(f"{name}: the quaternion (x, y, z, w) {rotation!r} has zero length")
+        x, y, z, w = quat / norm
+        return np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+    if items.shape != (3, 3) or not all(is_number(x) for x in items.ravel()):
+        raise InputError(
+            f"{name}: expected a quaternion (x, y, z, w) or a 3×3 rotation matrix, got {rotation!r}"
+        )
+    rot = items.astype(float)
+    if not np.all(np.isfinite(rot)):
+        raise InputError(f"{name}: contains NaN or infinite values")
+    error = float(np.max(np.abs(rot.T @ rot - np.eye(3))))
+    if error > ROTATION_TOLERANCE or np.linalg.det(rot) < 0:
+        raise InputError(
+            f"{name}: not a rotation matrix (|RᵀR − I| = {error:.3g}, det = "
+            f"{np.linalg.det(rot):.3g}); give an orthonormal matrix with determinant +1"
+        )
+    u, _, vt = np.linalg.svd(rot)  # nearest exact rotation
+    return u @ vt
+
+
+def as_pose(position=(0.0, 0.0, 0.0), rotation=None, name: str = "pose") -> coal.Transform3s:
+    """A coal placement from a position (3,) in metres and a rotation (see :func:`as_rotation`)."""
+    p = as_vector(position, 3, f"{name}.position")
+    return coal.Transform3s(as_rotation(rotation, f"{name}.rotation"), p)
+
+
+def bounding_sphere(shape) -> tuple[np.ndarray, float]:
+    """Centre (3,) in the shape's frame and radius (m) of a sphere enclosing the shape: coal's
+    local AABB centre and the radius of the sphere around that box."""
+    shape.computeLocalAABB()
+    return np.array(shape.aabb_center, dtype=float), float(shape.aabb_radius)
+
+
+__all__ = [
+    "MAX_COORDINATE",
+    "MIN_SIZE",
+    "REL_THICKNESS",
+    "as_pose",
+    "as_rotation",
+    "bounding_sphere",
+    "box",
+    "capsule",
+    "convex",
+    "cylinder",
+    "is_convex_mesh",
+    "load_mesh",
+    "mesh_hull",
+    "sphere",
+]

@@ -1,0 +1,197 @@
+"""3-D signed distance of gdnplan.arm3d against independent truth: finite differences, a QP
+over the shapes' vertices, the brute-force minimum (the broad phase changes nothing)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import minimize
+from scipy.spatial import ConvexHull
+
+from gdnplan.arm3d import (
+    Checker3D,
+    Coal3DModel,
+    Scene3D,
+    box_obstacle,
+    load_robot3d,
+    random_boxes,
+    signed_distance3d_and_grad,
+)
+from gdnplan.errors import InputError
+from gdnplan.models import DistanceModel
+
+
+@pytest.fixture(scope="module")
+def panda_scene():
+    return random_boxes(load_robot3d("panda"), 20, seed=1)
+
+
+@pytest.fixture(scope="module")
+def ur5e_scene():
+    return random_boxes(load_robot3d("ur5e"), 20, seed=1)
+
+
+def fd_checks(checker: Checker3D, qs: np.ndarray, per_link: bool = False, h: float = 1e-5):
+    """(gradient, central difference, distance) of every configuration whose minimising pair
+    is the same at q ± h e_j for every joint (away from switches) and needed no coal retry."""
+    out = []
+    dof = checker.robot.dof
+    for q in qs:
+        before = checker.fallbacks
+        res = checker.evaluate(q, per_link, gradient=True)
+        fd = np.zeros_like(res.gradient[0])
+        same = True
+        for j in range(dof):
+            e = np.zeros(dof)
+            e[j] = h
+            plus, minus = checker.evaluate(q + e, per_link), checker.evaluate(q - e, per_link)
+            same &= np.array_equal(plus.pair, res.pair) and np.array_equal(minus.pair, res.pair)
+            fd[..., j] = (plus.distance[0] - minus.distance[0]) / (2 * h)
+        if same and checker.fallbacks == before:
+            out.append((res.gradient[0], fd, res.distance[0]))
+    return out
+
+
+def test_panda_mesh_gradients_match_central_differences_apart_and_in_penetration(panda_scene):
+    checker = Checker3D(panda_scene, tolerance=1e-9)
+    qs = panda_scene.robot.random_configurations(60, np.random.default_rng(2))
+    checks = fd_checks(checker, qs)
+    assert len(checks) >= 40
+    depths = np.array([d for _, _, d in checks])
+    assert (depths < 0).sum() >= 3 and (depths > 0).sum() >= 20  # both regimes are tested
+    for g, fd, _ in checks:
+        assert np.linalg.norm(g - fd) <= 1e-5 * max(np.linalg.norm(fd), 1e-2)
+
+
+def test_panda_per_link_gradients_match_central_differences(panda_scene):
+    checker = Checker3D(panda_scene, tolerance=1e-9)
+    qs = panda_scene.robot.random_configurations(6, np.random.default_rng(3))
+    checks = fd_checks(checker, qs, per_link=True)
+    assert checks
+    for g, fd, _ in checks:
+        err = np.linalg.norm(g - fd, axis=-1)
+        assert np.all(err <= 1e-5 * np.maximum(np.linalg.norm(fd, axis=-1), 1e-2))
+
+
+def test_ur5e_primitive_gradients_match_central_differences(ur5e_scene):
+    """Cylinders are curved: GJK's witness direction converges only like the square root of
+    its distance tolerance (and EPA fails on them below ~1e-8), so the bounds here are 1e-4
+    relative at the median, 1e-3 for 90 % and 1e-2 for all (1e-5 for polytopes above)."""
+    checker = Checker3D(ur5e_scene, tolerance=1e-8)
+    qs = ur5e_scene.robot.random_configurations(60, np.random.default_rng(2))
+    checks = fd_checks(checker, qs)
+    assert len(checks) >= 30
+    depths = np.array([d for _, _, d in checks])
+    assert (depths < 0).sum() >= 3 and (depths > 0).sum() >= 10
+    errors = [np.linalg.norm(g - fd) / max(np.linalg.norm(fd), 1e-1) for g, fd, _ in checks]
+    assert np.median(errors) <= 1e-4 and np.quantile(errors, 0.9) <= 1e-3
+    assert max(errors) <= 1e-2
+
+
+def qp_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """Distance of the convex hulls of point sets a (n, 3) and b (m, 3), independent of coal:
+    the distance from the origin to the Minkowski difference hull{aᵢ − bⱼ} (Qhull), a QP in
+    three unknowns: min ‖x‖² s.t. the hull's facets n_f · x + o_f ≤ 0 (SLSQP)."""
+    diff = (a[:, None] - b[None]).reshape(-1, 3)
+    hull = ConvexHull(diff)
+    eq = hull.equations
+    cons = {
+        "type": "ineq",
+        "fun": lambda x: -(eq[:, :3] @ x + eq[:, 3]),
+        "jac": lambda x: -eq[:, :3],
+    }
+    x0 = diff[hull.vertices].mean(0)
+    res = minimize(
+        lambda x: (x @ x, 2 * x),
+        x0,
+        jac=True,
+        constraints=[cons],
+        method="SLSQP",
+        options={"ftol": 1e-14, "maxiter": 500},
+    )
+    assert np.max(eq[:, :3] @ res.x + eq[:, 3]) <= 1e-9, res.message  # feasible: in the hull
+    return float(np.linalg.norm(res.x))
+
+
+def box_corners(obstacle) -> np.ndarray:
+    half = np.asarray(obstacle.shape.halfSide)
+    corners = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T * half
+    return corners @ np.asarray(obstacle.pose.getRotation()).T + obstacle.pose.getTranslation()
+
+
+def test_separated_mesh_hull_distances_match_a_qp_over_the_vertices(panda_scene):
+    checker = Checker3D(panda_scene, tolerance=1e-10)
+    robot = panda_scene.robot
+    rng = np.random.default_rng(4)
+    compared = {"obstacle": 0, "self": 0}
+    for q in robot.random_configurations(12, rng):
+        tf = robot.shape_placements(q)
+        d, _ = checker.pair_distances(q)
+        world = [
+            np.asarray(s.shape.points()) @ t[:3, :3].T + t[:3, 3]
+            if hasattr(s.shape, "points")
+            else None
+            for s, t in zip(robot.shapes, tf, strict=True)
+        ]
+        for k in rng.permutation(checker.n_pairs)[:60]:
+            a, b = checker.pair_a[k], checker.pair_b[k]
+            if world[a] is None or not 0.005 < d[0, k] < 0.5:
+                continue
+            if checker.is_self[k]:
+                if world[b] is None:
+                    continue
+                other, kind = world[b], "self"
+            else:
+                other, kind = box_corners(panda_scene.obstacles[b]), "obstacle"
+            assert d[0, k] == pytest.approx(qp_distance(world[a], other), abs=2e-6)
+            compared[kind] += 1
+    assert compared["obstacle"] >= 10 and compared["self"] >= 3
+
+
+@given(
+    seed=st.integers(0, 1000), cap=st.sampled_from([0.02, 0.1, 0.5, np.inf]), per_link=st.booleans()
+)
+@settings(max_examples=25, deadline=None)
+def test_the_broad_phase_never_changes_the_minimum_below_the_cap(seed, cap, per_link):
+    robot = load_robot3d("ur5e")
+    scene = random_boxes(robot, 20, seed=seed)
+    checker = Checker3D(scene)
+    q = robot.random_configurations(3, np.random.default_rng(seed))
+    brute, narrow_all = checker.pair_distances(q)  # every pair, no cap
+    assert np.all(narrow_all == checker.n_pairs)
+    res = checker.evaluate(q, per_link=per_link, cap=cap)
+    if per_link:
+        for link in range(robot.n_links):
+            involved = (checker.link_a == link) | (checker.link_b == link)
+            expected = np.minimum(brute[:, involved].min(1), cap)
+            np.testing.assert_array_equal(res.distance[:, link], expected)
+    else:
+        np.testing.assert_array_equal(res.distance, np.minimum(brute.min(1), cap))
+    assert np.all(res.narrow <= checker.n_pairs)
+    off = checker.evaluate(q, per_link=per_link, cap=cap, broad_phase=False)
+    np.testing.assert_array_equal(off.distance, res.distance)
+
+
+def test_capped_results_have_zero_gradient_and_no_pair():
+    robot = load_robot3d("ur5e")
+    far = Scene3D(robot, [box_obstacle((0.1, 0.1, 0.1), (5.0, 0.0, 0.0))])
+    checker = Checker3D(far)
+    # the home pose: self pairs are > 1 cm apart; a 5 mm cap leaves nothing to evaluate
+    res = checker.evaluate([0.0, -1.57, 1.57, -1.57, -1.57, 0.0], cap=0.005, gradient=True)
+    assert res.distance[0] == 0.005 and res.pair[0] == -1 and not res.gradient.any()
+    with pytest.raises(InputError, match="cap"):
+        checker.evaluate(np.zeros(6), cap=float("nan"))
+
+
+def test_coal3d_model_is_a_distance_model(ur5e_scene):
+    model = Coal3DModel()
+    assert isinstance(model, DistanceModel)
+    q = ur5e_scene.robot.random_configurations(4, np.random.default_rng(0))
+    d, g = model.distance_and_grad(ur5e_scene, q)
+    assert d.shape == (4,) and g.shape == (4, 6)
+    np.testing.assert_array_equal(d, model.distance(ur5e_scene, q))
+    d2, g2 = signed_distance3d_and_grad(ur5e_scene, q, per_link=True)
+    assert d2.shape == (4, ur5e_scene.robot.n_links) and g2.shape == (4, d2.shape[1], 6)
+    np.testing.assert_allclose(d2.min(1), d)

@@ -1,0 +1,137 @@
+"""3-D robots of gdnplan.arm3d: kinematics, self-collision pairs against the SRDF, bad input."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from gdnplan.arm3d import Scene3D, checker3d, load_robot3d, robot3d_from_urdf
+from gdnplan.arm3d.builtin import _example_robot_data
+from gdnplan.arm3d.pairs import checked_link_pairs
+from gdnplan.assets import robot_urdf
+from gdnplan.errors import InputError, UnknownNameError
+
+
+@pytest.fixture(scope="module", params=["ur5e", "panda", "ur5"])
+def robot(request):
+    return load_robot3d(request.param)
+
+
+def test_builtin_robots_have_their_joints_and_shapes(robot):
+    expected = {"ur5e": (6, "Cylinder"), "panda": (7, "ConvexBase"), "ur5": (6, "ConvexBase")}
+    dof, kind = expected[robot.name]
+    assert robot.dof == dof and robot.model.nv == dof
+    assert kind in {type(s.shape).__name__ for s in robot.shapes}
+    assert len(robot.self_pairs) > 0
+
+
+def test_point_jacobian_matches_finite_differences_of_forward_kinematics(robot):
+    rng = np.random.default_rng(1)
+    for q in robot.random_configurations(5, rng):
+        s = int(rng.integers(len(robot.shapes)))
+        local = rng.normal(size=3) * 0.05  # a point in shape s's frame
+
+        def world(qq, s=s, local=local):
+            tf = robot.shape_placements(qq)[s]
+            return tf[:3, :3] @ local + tf[:3, 3]
+
+        jac = robot.point_jacobian(q, robot.shapes[s].body, world(q))
+        h = 1e-6
+        fd = np.stack([(world(q + e) - world(q - e)) / (2 * h) for e in np.eye(robot.dof) * h], 1)
+        np.testing.assert_allclose(jac, fd, atol=1e-8)
+
+
+def test_self_collision_pairs_are_the_srdf_complement_pinocchio_computes():
+    """Independent truth: Pinocchio's own SRDF reader on the full geometry model."""
+    for name in ("panda", "ur5"):
+        robot = load_robot3d(name)
+        urdf, srdf, _ = _example_robot_data(name)
+        model = pin.buildModelFromUrdf(str(urdf))
+        dirs = [str(p) for p in urdf.parents]
+        geom = pin.buildGeomFromUrdf(
+            model, str(urdf), pin.GeometryType.COLLISION, package_dirs=dirs
+        )
+        geom.addAllCollisionPairs()
+        pin.removeCollisionPairs(model, geom, str(srdf))
+        link = {i: model.frames[g.parentFrame].name for i, g in enumerate(geom.geometryObjects)}
+        pin_pairs = {frozenset((link[p.first], link[p.second])) for p in geom.collisionPairs}
+        pin_pairs = {p for p in pin_pairs if len(p) == 2}
+        structural = {k for k, why in robot.disabled.items() if why in ("adjacent", "same body")}
+        assert checked_link_pairs(robot) == pin_pairs - structural, name
+        # and every SRDF pair is unchecked, every unchecked pair has a reason
+        assert not checked_link_pairs(robot) & set(robot.disabled)
+
+
+def test_every_link_pair_is_checked_or_disabled_with_a_reason(robot):
+    all_pairs = {frozenset(p) for p in itertools.combinations(robot.links, 2)}
+    assert checked_link_pairs(robot) | set(robot.disabled) == all_pairs
+    for a, b in (tuple(k) for k in robot.disabled):
+        ba = robot.shapes[list(robot.shape_link).index(robot.links.index(a))].body
+        bb = robot.shapes[list(robot.shape_link).index(robot.links.index(b))].body
+        why = robot.disabled[frozenset((a, b))]
+        assert (why == "same body") == (ba == bb)
+
+
+def test_reference_configurations_are_free_of_self_collision():
+    homes = {
+        "ur5e": [0.0, -1.57, 1.57, -1.57, -1.57, 0.0],
+        "panda": [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785],  # the SRDF's "default"
+        "ur5": [0.0, -1.57, 1.57, -1.57, -1.57, 0.0],
+    }
+    for name, q in homes.items():
+        robot = load_robot3d(name)
+        assert checker3d(Scene3D(robot, [])).evaluate(q).distance[0] > 0, name
+
+
+@pytest.mark.parametrize(
+    "q, match",
+    [([0.0] * 5, r"shape \(B, 6\)"), ([0.0] * 5 + [np.nan], "NaN"), ("abc", "numbers|shape")],
+)
+def test_bad_configurations_are_one_line_input_errors(q, match):
+    scene = Scene3D(load_robot3d("ur5e"), [])
+    with pytest.raises(InputError, match=match) as e:
+        checker3d(scene).evaluate(q)
+    assert "\n" not in str(e.value)
+
+
+URDF = """<robot name="r">
+  <link name="a"><collision><geometry>{geometry}</geometry></collision></link>
+  <link name="b"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>"""
+
+
+def test_a_user_urdf_with_a_missing_mesh_or_a_flat_box_is_an_input_error(tmp_path):
+    ok = tmp_path / "ok.urdf"
+    ok.write_text(URDF.format(geometry='<sphere radius="0.1"/>'))
+    robot = robot3d_from_urdf(ok)
+    assert robot.dof == 1 and robot.links == ("a", "b") and robot.disabled
+    missing = tmp_path / "missing.urdf"
+    missing.write_text(URDF.format(geometry='<mesh filename="nowhere.stl"/>'))
+    with pytest.raises((InputError, UnknownNameError)) as e:
+        robot3d_from_urdf(missing)
+    assert "\n" not in str(e.value)
+    flat = tmp_path / "flat.urdf"
+    flat.write_text(URDF.format(geometry='<box size="0.1 0.1 0"/>'))
+    with pytest.raises(InputError, match="size"):
+        robot3d_from_urdf(flat)
+
+
+def test_unknown_names_and_joint_order(tmp_path):
+    with pytest.raises(UnknownNameError, match="choose one of"):
+        load_robot3d("kuka")
+    with pytest.raises(UnknownNameError, match="not a joint"):
+        robot3d_from_urdf(robot_urdf("ur5e"), joints=["shoulder_pan_joint", "nope"])
+    with pytest.raises(InputError, match="URDF's order"):
+        robot3d_from_urdf(robot_urdf("ur5e"), joints=["elbow_joint", "shoulder_pan_joint"])
+    with pytest.raises(InputError, match="not a revolute"):
+        robot3d_from_urdf(robot_urdf("ur5e"), joints=["left_finger_joint"])
+    srdf = tmp_path / "other.srdf"
+    srdf.write_text('<robot><disable_collisions link1="x" link2="base_link"/></robot>')
+    with pytest.raises(InputError, match="link 'x'"):
+        robot3d_from_urdf(robot_urdf("ur5e"), srdf=srdf)

@@ -1,0 +1,147 @@
+"""Shape and pose validation of gdnplan.arm3d: bad geometry never reaches coal (which crashes)."""
+
+from __future__ import annotations
+
+import logging
+
+import coal
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from gdnplan.arm3d import box_obstacle, mesh_obstacle
+from gdnplan.arm3d.shapes import as_pose, as_rotation, box, convex, is_convex_mesh, load_mesh
+from gdnplan.errors import InputError, UnknownNameError
+
+CUBE = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T * 0.1
+
+
+def coal_distance(a, tf_a, b, tf_b) -> float:
+    req = coal.DistanceRequest()
+    req.enable_signed_distance = True
+    return coal.distance(a, tf_a, b, tf_b, req, coal.DistanceResult())
+
+
+def write_stl(path, vertices, faces) -> None:
+    """An ASCII STL of triangles (index triples into vertices)."""
+    lines = ["solid t"]
+    for f in faces:
+        a, b, c = (vertices[i] for i in f)
+        n = np.cross(b - a, c - a)
+        n = n / np.linalg.norm(n)
+        lines += [f"facet normal {n[0]} {n[1]} {n[2]}", "outer loop"]
+        lines += [f"vertex {p[0]} {p[1]} {p[2]}" for p in (a, b, c)]
+        lines += ["endloop", "endfacet"]
+    path.write_text("\n".join([*lines, "endsolid t"]) + "\n")
+
+
+def dented_cube(depth: float):
+    """A cube of side 0.2 whose +z face is four triangles to a vertex pushed ``depth`` inward."""
+    v = np.vstack([CUBE, [[0.0, 0.0, 0.1 - depth]]])
+    idx = {tuple(np.sign(p).astype(int)): i for i, p in enumerate(CUBE)}
+
+    def quad(a, b, c, d):
+        return [(idx[a], idx[b], idx[c]), (idx[a], idx[c], idx[d])]
+
+    faces = quad((-1, -1, -1), (-1, 1, -1), (1, 1, -1), (1, -1, -1))
+    faces += quad((-1, -1, -1), (1, -1, -1), (1, -1, 1), (-1, -1, 1))
+    faces += quad((1, -1, -1), (1, 1, -1), (1, 1, 1), (1, -1, 1))
+    faces += quad((1, 1, -1), (-1, 1, -1), (-1, 1, 1), (1, 1, 1))
+    faces += quad((-1, 1, -1), (-1, -1, -1), (-1, -1, 1), (-1, 1, 1))
+    top = [(-1, -1, 1), (1, -1, 1), (1, 1, 1), (-1, 1, 1)]
+    faces += [(idx[top[k]], idx[top[(k + 1) % 4]], 8) for k in range(4)]
+    return v, faces
+
+
+@pytest.mark.parametrize(
+    "points, match",
+    [
+        (np.c_[np.random.default_rng(0).normal(size=(50, 2)), np.zeros(50)], "flat"),
+        (np.random.default_rng(0).normal(size=(50, 3)) * [1, 1, 1e-12], "flat"),
+        (np.random.default_rng(0).normal(size=(50, 3)) * [1, 1, 1e-6], "flat"),
+        (np.random.default_rng(0).normal(size=(50, 3)) * 1e9, "beyond"),
+        (np.full((10, 3), np.nan), "NaN"),
+        (np.zeros((3, 3)), "4 ≤ k"),
+        (np.outer(np.linspace(0, 1, 20), [1.0, 2.0, 3.0]), "flat"),
+    ],
+)
+def test_bad_point_sets_raise_one_line_input_errors_not_segfaults(points, match):
+    with pytest.raises(InputError, match=match) as e:
+        convex(points, "part")
+    assert "\n" not in str(e.value) and str(e.value).startswith("part")
+
+
+def test_a_thin_but_valid_plate_is_accepted_and_measured_by_coal():
+    plate = convex(CUBE * [5, 5, 0.01], "plate")  # 1 m × 1 m × 2 mm
+    d = coal_distance(plate, coal.Transform3s(), coal.Sphere(0.1), as_pose((0, 0, 0.5)))
+    assert d == pytest.approx(0.5 - 0.001 - 0.1, abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    "size", [(0.1, 0.1, 0.0), (0.1, np.nan, 0.1), (0.1, 1e9, 0.1), (0.1, 0.1), (True, 1, 1)]
+)
+def test_bad_box_sizes_are_input_errors(size):
+    with pytest.raises(InputError, match="size"):
+        box(size)
+
+
+@given(st.integers(0, 10_000))
+@settings(max_examples=30, deadline=None)
+def test_quaternion_and_matrix_poses_agree(seed):
+    rot = Rotation.random(random_state=seed)
+    from_quat = as_rotation(rot.as_quat())  # scipy's (x, y, z, w) order
+    np.testing.assert_allclose(from_quat, rot.as_matrix(), atol=1e-12)
+    np.testing.assert_allclose(as_rotation(rot.as_matrix()), rot.as_matrix(), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "rotation, match",
+    [
+        (np.diag([1.0, 1.0, -1.0]), "not a rotation"),  # a reflection
+        (np.eye(3) * 2, "not a rotation"),
+        (np.ones((3, 3)), "not a rotation"),
+        ((0, 0, 0, 0), "zero length"),
+        ((0, 0, 1), "quaternion"),
+        (np.full((3, 3), np.nan), "NaN"),
+    ],
+)
+def test_a_pose_that_is_not_a_rotation_is_an_input_error(rotation, match):
+    with pytest.raises(InputError, match=match) as e:
+        box_obstacle((0.1, 0.1, 0.1), (0.5, 0, 0), rotation, name="wall")
+    assert str(e.value).startswith("wall.rotation") and "\n" not in str(e.value)
+
+
+def test_missing_mesh_and_a_file_that_is_not_a_mesh(tmp_path):
+    with pytest.raises(UnknownNameError, match="does not exist"):
+        mesh_obstacle(tmp_path / "nope.stl")
+    bad = tmp_path / "bad.stl"
+    bad.write_text("this is not a mesh\n")
+    with pytest.raises(InputError, match="not a mesh file") as e:
+        mesh_obstacle(bad)
+    assert "\n" not in str(e.value)
+
+
+def test_a_convex_mesh_file_loads_as_its_hull(tmp_path, caplog):
+    v, faces = dented_cube(0.0)  # the fifth top vertex lies on the face: convex
+    path = tmp_path / "cube.stl"
+    write_stl(path, v, faces)
+    with caplog.at_level(logging.INFO, logger="gdnplan.arm3d"):
+        hull = load_mesh(path)
+    assert not caplog.records and is_convex_mesh(v)
+    d = coal_distance(hull, coal.Transform3s(), coal.Sphere(0.05), as_pose((0.4, 0, 0)))
+    assert d == pytest.approx(0.4 - 0.1 - 0.05, abs=1e-6)
+
+
+def test_a_non_convex_mesh_becomes_its_hull_with_a_logged_note(tmp_path, caplog):
+    v, faces = dented_cube(0.15)
+    path = tmp_path / "dented.stl"
+    write_stl(path, v, faces)
+    assert not is_convex_mesh(v)
+    with caplog.at_level(logging.INFO, logger="gdnplan.arm3d"):
+        obs = mesh_obstacle(path, name="dented")
+    assert any("not convex" in r.getMessage() for r in caplog.records)
+    # the hull is the full cube: a sphere above the dent is as far as from the cube's top
+    d = coal_distance(obs.shape, obs.pose, coal.Sphere(0.05), as_pose((0, 0, 0.3)))
+    assert d == pytest.approx(0.3 - 0.1 - 0.05, abs=1e-6)
