@@ -36,7 +36,10 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "scene",
         ),
     ),
-    ("exact geometry and seeds", ("distance", "ccd", "ccd_curve", "rrt", "ur5e")),
+    (
+        "exact geometry and seeds",
+        ("distance", "ccd", "ccd_curve", "rrt", "ur5e", "path_metrics", "ompl_planner"),
+    ),
     ("graphs", ("graph",)),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
