@@ -149,14 +149,22 @@ def table(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\n" + ratios(records)
 
 
+def _ratio(q: list[float]) -> str:
+    """'median [n] | max | wins/n' of the paired ratios q."""
+    if not q:
+        return "– [0] | – | 0/0"
+    wins = sum(x <= 1.0 for x in q)
+    return f"{np.median(q):.3f} [{len(q)}] | {max(q):.3g} | {wins}/{len(q)}"
+
+
 def ratios(records: list[dict]) -> str:
     """Median over problems of cost(gdnplan) / min over OMPL planners of cost, per budget."""
     lines = [
         "Paired cost ratio gdnplan / best OMPL planner at each budget (median over the problems "
         "both solved [n]; ≤ 1: gdnplan is cheaper; wins: problems with ratio ≤ 1):",
         "",
-        "| setting | gdnplan | OMPL budget | median ratio [n] | wins |",
-        "|---|---|---|---|---|",
+        "| setting | gdnplan | OMPL budget | median ratio [n] | max ratio | wins |",
+        "|---|---|---|---|---|---|",
     ]
     budgets = [*dict.fromkeys(r["budget"] for r in records if r["budget"]), "any"]
     for env in dict.fromkeys(r["env"] for r in records):
@@ -169,15 +177,11 @@ def ratios(records: list[dict]) -> str:
                     if r["method"].startswith("OMPL") and budget in (r["budget"], "any"):
                         best[r["problem"]] = min(best.get(r["problem"], np.inf), r["cost"])
                 q = [ours[p] / best[p] for p in ours if p in best and best[p] > 0]
-                med = f"{np.median(q):.3f} [{len(q)}]" if q else "– [0]"
-                wins = sum(x <= 1.0 for x in q)
-                lines.append(f"| {env} | {method} | {budget} | {med} | {wins}/{len(q)} |")
+                lines.append(f"| {env} | {method} | {budget} | {_ratio(q)} |")
         coal = {r["problem"]: r["cost"] for r in mine if r["method"] == "gdnplan coal"}
         gdn = {r["problem"]: r["cost"] for r in mine if r["method"] == "gdnplan GraphDistNet"}
         q = [gdn[p] / coal[p] for p in gdn if p in coal and coal[p] > 0]
-        med = f"{np.median(q):.3f} [{len(q)}]" if q else "– [0]"
-        wins = sum(x <= 1.0 for x in q)
-        lines.append(f"| {env} | GraphDistNet / coal | (gdnplan coal) | {med} | {wins}/{len(q)} |")
+        lines.append(f"| {env} | GraphDistNet / coal | (gdnplan coal) | {_ratio(q)} |")
     return "\n".join(lines) + "\n"
 
 
@@ -192,9 +196,10 @@ OMPL's time includes simplification (at most one more budget). Times on a shared
 """
 
 
-def write(records: list[dict], command: str, out: Path) -> None:
+def write(records: list[dict], head: str, out: Path) -> None:
+    """The markdown: title, ``head`` (:func:`header`'s lines), tables, notes."""
     out.parent.mkdir(parents=True, exist_ok=True)
-    text = "# gdnplan vs OMPL on the Table II problems\n\n" + header(command) + "\n"
+    text = "# gdnplan vs OMPL on the Table II problems\n\n" + head + "\n"
     out.write_text(text + table(records) + NOTES)
 
 
@@ -207,7 +212,16 @@ def main() -> None:
     parser.add_argument("--planners", nargs="+", default=["rrtconnect", "bitstar", "aorrtc"])
     parser.add_argument("--seed", type=int, default=0, help="OMPL's random seed")
     parser.add_argument("--out", type=Path, default=OUT)
+    parser.add_argument(
+        "--render", type=Path, help="only rewrite --out from this records file (.jsonl)"
+    )
     args = parser.parse_args()
+    if args.render:
+        records = [json.loads(ln) for ln in args.render.read_text().splitlines() if ln]
+        old = args.out.read_text().splitlines() if args.out.exists() else []
+        keys = ("- command: ", "- machine: ", "- date: ")
+        write(records, "".join(ln + "\n" for ln in old if ln.startswith(keys)), args.out)
+        return
     import torch
 
     from gdnplan.models import set_inference_threads
@@ -219,6 +233,7 @@ def main() -> None:
     jsonl.parent.mkdir(parents=True, exist_ok=True)
     jsonl.write_text("")
     records: list[dict] = []
+    head = header(command)  # the date the run started
     for env in args.envs:
         model = gp.load_model(WEIGHTS_ENV[env])
         for i, problem in enumerate(reaching_problems(env, n=args.problems)):
@@ -226,7 +241,7 @@ def main() -> None:
             records += recs
             with jsonl.open("a") as f:
                 f.writelines(json.dumps(r) + "\n" for r in recs)
-            write(records, command, args.out)
+            write(records, head, args.out)
             summary = ", ".join(
                 f"{r['method'].split()[-1]} {r['budget'] or ''}: "
                 + ("-" if r["cost"] is None else f"{r['cost']:.3g}")
