@@ -116,7 +116,8 @@ def run_problem(env: str, i: int, problem, model, args) -> list[dict]:
                 upper=problem.upper,
             )
             rec = {"env": env, "problem": i, "method": f"OMPL {planner}", "budget": label}
-            out.append(rec | {"time": r.time} | judged(problem, r.path, r.success))
+            rec |= {"time": r.time, "status": r.status}  # OMPL's: tells timeouts apart
+            out.append(rec | judged(problem, r.path, r.success))
     return out
 
 
