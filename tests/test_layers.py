@@ -62,6 +62,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d",
             "arm3d.distance3d",
             "arm3d.ccd3d",
+            "path_metrics",
+            "ompl_planner",
         ),
     ),
     ("graphs", ("graph",)),

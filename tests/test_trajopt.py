@@ -341,6 +341,28 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
     assert 0 < expected_raised.sum() < len(second)  # some check points keep the plain margin
 
 
+def test_refine_rounds_raise_to_the_overestimate_not_its_sum(square, monkeypatch):
+    """Active check points sit at d̂ = bound, so coal's distance there is bound − (d̂ − d): a
+    raise equal to the model's overestimate d̂ − d suffices, and a later round that finds the
+    same overestimate must not add it again. _Liar overestimates by 1 m − d (d ≥ −0.5 m in the
+    square), so after two rounds the raise stays below 1.5 m (a sum would be over 2 m)."""
+    margins = []
+    original = trajopt._Transcription.__init__
+
+    def record(self, problem, model, goal, opts, splits, margin, warm=False):
+        margins.append(np.broadcast_to(margin, (int(splits.sum()) - 1,)).copy())
+        original(self, problem, model, goal, opts, splits, margin, warm)
+
+    monkeypatch.setattr(trajopt._Transcription, "__init__", record)
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
+    opts = TrajoptOptions(initial="rrt", refine_rounds=2, starts=1, raise_window=None)
+    assert not plan(p, collision=_Liar(), options=opts).success
+    base = trajopt.check_points.constraint_margin(p, opts.clearance_buffer)
+    assert len(margins) == 3
+    assert 0.9 < np.max(margins[1] - base) < 1.5
+    assert 0.9 < np.max(margins[2] - base) < 1.5
+
+
 @pytest.mark.parametrize(
     ("settings", "field"),
     [

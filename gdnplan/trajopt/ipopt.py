@@ -116,7 +116,7 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
     clearance + ``opts.clearance_buffer`` if that is more); the certificate must prove
     d > ``problem.certified_clearance`` on the whole continuous path.
     Each round that the coal certificate rejects doubles the check points of the rejected
-    segments and, for a learned model, raises the constraint margin by the model's observed
+    segments and, for a learned model, raises the constraint margin to the model's observed
     overestimate there (:func:`model_overestimate`) on the rejected segments and
     ``opts.raise_window`` segments either side: the learned constraint then keeps the path
     away from the contact coal found, whatever the model's error. (On the rejected segments
@@ -166,5 +166,6 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         splits = refined
         if learned:
             over = model_overestimate(problem.scene, model, q, bad, base)
-            raised[_near_segments(bad, len(splits), opts.raise_window)] += over
+            near = _near_segments(bad, len(splits), opts.raise_window)  # active rows sit at
+            raised[near] = np.maximum(raised[near], over)  # d̂ = bound: raise to the error, no sum
     return q, stats, False

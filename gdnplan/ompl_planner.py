@@ -1,0 +1,187 @@
+"""Sampling-based planners of OMPL (optional: ``pip install gdnplan[bench]``) on gdnplan's
+validity rule: joint-space paths whose whole continuous motion is certified above a clearance.
+
+The state space is ℝ^dof bounded by the joint limits (lower, upper); a state q is valid when
+coal's proven distance lower bound d̲(q) = d_coal(q) − COAL_SLACK (1 + |d_coal(q)|)
+(:func:`gdnplan.ccd.proven_distance`) is > ``clearance`` (m), and a motion qa → qb is valid when
+:func:`gdnplan.rrt.edge_free` certifies the straight segment above ``clearance`` by conservative
+advancement — the certificate that accepts gdnplan's own RRT-Connect edges and judges every
+:func:`gdnplan.plan`. OMPL's path simplifier checks its shortcuts with the same motion validator,
+so an OMPL path is certified segment by segment as it is built; :func:`plan_ompl` still certifies
+the returned path once more with :func:`gdnplan.ccd.certify_path` (its proven lower bound is
+``OmplResult.clearance``) and reports failure if that certificate does not hold.
+
+Planners by name (:data:`PLANNERS`): ``rrtconnect`` (feasible, returns at the first path),
+and the asymptotically optimal ``bitstar``, ``aorrtc``, ``rrtstar`` (under OMPL's path-length
+objective Σ_k ‖q_{k+1} − q_k‖, they use the whole time budget). OMPL is imported when first used.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .ccd import Certificate, certify_path, proven_distance
+from .distance import signed_distance
+from .errors import InputError
+from .limits import check_number
+from .rrt import edge_free
+from .scene import Scene
+
+PLANNERS = {  # name -> OMPL geometric planner class
+    "rrtconnect": "RRTConnect",
+    "bitstar": "BITstar",
+    "aorrtc": "AORRTC",
+    "rrtstar": "RRTstar",
+}
+MAX_TIME = 600.0  # s, one planning call
+_SEEDED: list[int] = []  # OMPL's global seed can be set once per process, before any planner
+
+
+def _ompl():
+    """(ompl.base, ompl.geometric, ompl.util), or InputError saying how to install OMPL."""
+    try:
+        from ompl import base as ob
+        from ompl import geometric as og
+        from ompl import util as ou
+    except ImportError as e:
+        raise InputError(
+            f"OMPL is not installed ({e}); install gdnplan[bench] (pip install 'ompl>=2.0')"
+        ) from e
+    return ob, og, ou
+
+
+@dataclass(frozen=True)
+class OmplResult:
+    """Result of :func:`plan_ompl`.
+
+    Attributes:
+        success: OMPL found an exact solution and :func:`gdnplan.ccd.certify_path` proves the
+            returned continuous path keeps the proven distance > the clearance.
+        path: (K, dof) waypoints (rad), start first, goal last; (0, dof) when OMPL found none.
+        time: wall time of planning and simplification (s).
+        planner: the planner's name (a key of :data:`PLANNERS`).
+        status: OMPL's planner status ("Exact solution", "Timeout", …).
+        clearance: proven lower bound on the signed distance along the whole path (m, the
+            certificate's); −inf when not proven or no path.
+        certificate: the final certificate (None without a path).
+    """
+
+    success: bool
+    path: np.ndarray
+    time: float
+    planner: str
+    status: str
+    clearance: float
+    certificate: Certificate | None
+
+
+def _seed(ou, seed: int) -> None:
+    """Seed OMPL's random generators once per process (OMPL ignores later seeds with a warning)."""
+    if not _SEEDED:
+        ou.RNG.setSeed(int(seed))
+        _SEEDED.append(int(seed))
+
+
+def _setup(ob, scene: Scene, lower: np.ndarray, upper: np.ndarray, clearance: float):
+    """SpaceInformation over the joint box with the certified state and motion checks."""
+    dof = scene.robot.dof
+    space = ob.RealVectorStateSpace(dof)
+    bounds = ob.RealVectorBounds(dof)
+    for j in range(dof):
+        bounds.setLow(j, float(lower[j]))
+        bounds.setHigh(j, float(upper[j]))
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+
+    def vector(state) -> np.ndarray:
+        return np.array([state[j] for j in range(dof)])
+
+    def valid(state) -> bool:
+        q = vector(state)
+        if np.any(q < lower) or np.any(q > upper):
+            return False
+        return bool(proven_distance(signed_distance(scene, q))[0] > clearance)
+
+    class CertifiedMotion(ob.MotionValidator):
+        def checkMotion(self, a, b) -> bool:  # OMPL's name
+            return edge_free(scene, vector(a), vector(b), clearance)
+
+    si.setStateValidityChecker(valid)
+    motion = CertifiedMotion(si)
+    si.setMotionValidator(motion)
+    si.setup()
+    return si, motion, vector
+
+
+def _check(scene: Scene, start, goal, lower, upper, clearance, time_limit, planner):
+    robot = scene.robot
+    if planner not in PLANNERS:
+        raise InputError(f"planner: unknown {planner!r}; choose from {sorted(PLANNERS)}")
+    check_number(clearance, "clearance")
+    if check_number(time_limit, "time_limit", strict=True) > MAX_TIME:
+        raise InputError(f"time_limit: {time_limit} s is over the limit {MAX_TIME} s")
+    lower = robot.lower if lower is None else np.asarray(lower, float)
+    upper = robot.upper if upper is None else np.asarray(upper, float)
+    start = robot.check_q(np.asarray(start, float), "start").reshape(-1)
+    goal = robot.check_q(np.asarray(goal, float), "goal").reshape(-1)
+    return start, goal, lower, upper
+
+
+def plan_ompl(
+    scene: Scene,
+    start: np.ndarray,
+    goal: np.ndarray,
+    clearance: float,
+    planner: str = "rrtconnect",
+    time_limit: float = 1.0,
+    simplify: bool = True,
+    seed: int = 0,
+    lower: np.ndarray | None = None,
+    upper: np.ndarray | None = None,
+) -> OmplResult:
+    """Plan start → goal (dof,) with OMPL's ``planner`` within ``time_limit`` (s of planning).
+
+    ``simplify``: OMPL's ``PathSimplifier`` (vertex reduction, shortcuts, B-spline smoothing,
+    every change checked by the certified motion validator) runs afterwards, with at most
+    ``time_limit`` more seconds; ``OmplResult.time`` includes it. ``lower``/``upper`` (dof,):
+    the joint box (the robot's limits when None). ``seed`` seeds OMPL's generators the first
+    time any planner runs in this process (OMPL allows one global seed); a run is reproducible
+    for the same seed and sequence of calls up to time limits (an anytime planner's result
+    depends on how far it got in its time). Raises InputError on bad input or without OMPL.
+    """
+    start, goal, lower, upper = _check(
+        scene, start, goal, lower, upper, clearance, time_limit, planner
+    )
+    ob, og, ou = _ompl()
+    ou.setLogLevel(ou.LOG_ERROR)
+    _seed(ou, seed)
+    t0 = time.perf_counter()
+    si, _, vector = _setup(ob, scene, lower, upper, clearance)
+    ss = og.SimpleSetup(si)
+    a, b = si.allocState(), si.allocState()
+    for j in range(scene.robot.dof):
+        a[j], b[j] = float(start[j]), float(goal[j])
+    ss.setStartAndGoalStates(a, b)
+    ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+    ss.setPlanner(getattr(og, PLANNERS[planner])(si))
+    status = str(ss.solve(float(time_limit)))
+    dof = scene.robot.dof
+    if not ss.haveExactSolutionPath():
+        return OmplResult(
+            False, np.zeros((0, dof)), time.perf_counter() - t0, planner, status, -math.inf, None
+        )
+    if simplify:
+        ss.simplifySolution(float(time_limit))
+    sol = ss.getSolutionPath()
+    path = np.array([vector(sol.getState(i)) for i in range(sol.getStateCount())])
+    path[0], path[-1] = start, goal  # OMPL's goal test is exact for a state goal
+    elapsed = time.perf_counter() - t0
+    cert = certify_path(scene, path, margin=clearance)
+    return OmplResult(cert.ok, path, elapsed, planner, status, cert.lower_bound, cert)
+
+
+__all__ = ["PLANNERS", "OmplResult", "plan_ompl"]

@@ -1,0 +1,62 @@
+"""gdnplan.ompl_planner: OMPL's planners on the certified validity rule (smoke tests, fast)."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+
+from gdnplan.ccd import certify_path
+from gdnplan.distance import signed_distance
+from gdnplan.errors import InputError
+from gdnplan.trajopt import Problem, straight_line
+
+pytest.importorskip("ompl")
+
+from gdnplan.ompl_planner import PLANNERS, plan_ompl
+
+
+@pytest.fixture(scope="module")
+def square() -> Problem:
+    """planar2 around the square: the straight joint-space line is not free."""
+    return Problem.from_toml("planar2_square")
+
+
+@pytest.mark.parametrize("planner", ["rrtconnect", "aorrtc"])
+def test_paths_are_certified_around_the_square(square, planner):
+    """The path joins start and goal, stays in the limits, and is certified above the
+    clearance; coal on a dense sampling of it (independent of the certificate) agrees."""
+    p, c = square, square.certified_clearance
+    assert not certify_path(p.scene, straight_line(p.start, p.goal, 20), margin=c).ok
+    r = plan_ompl(p.scene, p.start, p.goal, c, planner, time_limit=0.3, seed=0)
+    assert r.success, r.status
+    assert r.planner == planner
+    np.testing.assert_array_equal(r.path[0], p.start)
+    np.testing.assert_array_equal(r.path[-1], p.goal)
+    assert len(r.path) >= 3  # it had to bend
+    assert np.all(r.path >= p.lower) and np.all(r.path <= p.upper)
+    assert r.certificate.ok and r.clearance > c
+    s = np.linspace(0.0, 1.0, 200)[:, None]
+    dense = np.vstack([a + s * (b - a) for a, b in zip(r.path[:-1], r.path[1:], strict=True)])
+    assert signed_distance(p.scene, dense).min() > c
+
+
+def test_an_impossible_clearance_fails_cleanly(square):
+    """Start and goal are not valid at 10 m clearance: no path, success False, no crash."""
+    p = square
+    r = plan_ompl(p.scene, p.start, p.goal, 10.0, "rrtconnect", time_limit=0.05)
+    assert not r.success
+    assert r.path.shape == (0, 2) and r.clearance == -np.inf
+
+
+def test_bad_input_and_missing_ompl(square, monkeypatch):
+    p = square
+    with pytest.raises(InputError, match="planner"):
+        plan_ompl(p.scene, p.start, p.goal, 0.02, "prm")
+    with pytest.raises(InputError, match="time_limit"):
+        plan_ompl(p.scene, p.start, p.goal, 0.02, "rrtconnect", time_limit=0.0)
+    assert set(PLANNERS) >= {"rrtconnect", "bitstar", "aorrtc"}
+    monkeypatch.setitem(sys.modules, "ompl", None)  # import ompl now raises ImportError
+    with pytest.raises(InputError, match=r"gdnplan\[bench\]"):
+        plan_ompl(p.scene, p.start, p.goal, 0.02)
