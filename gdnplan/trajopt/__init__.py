@@ -28,7 +28,10 @@ rounds.
 dropped: at 3 check points per segment δ reaches ~1 m on seed paths, the rows are infeasible
 and Ipopt runs to its iteration cap.) Ipopt uses a limited-memory Hessian and starts from the
 straight line when it is certified free (then it is already optimal and returned as is) or
-from RRT-Connect seeds, restarting from a new seed on failure. A plan succeeds only when
+from seed paths (:mod:`gdnplan.trajopt.seeds`: RRT-Connect, a via point, or any registered
+kind), replacing a seed whose path ends uncertified; with ``SeedConfig.count`` > 1 (or a
+``time_budget``) it refines several seeds and returns the certified path of least path cost.
+A plan succeeds only when
 :func:`gdnplan.ccd.certify_path` proves with coal that the whole returned path keeps d > c
 (``Plan.min_distance`` is that proven bound) and the goal is reached — never on the solver's
 word alone.
