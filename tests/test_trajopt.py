@@ -405,6 +405,7 @@ def test_deprecated_trajopt_options_reject_bad_settings(settings, field):
         (SeedConfig, {"count": 51}, "count"),
         (SeedConfig, {"kinds": ("nope",)}, "kinds"),
         (SeedConfig, {"kinds": ()}, "kinds"),
+        (SeedConfig, {"kinds": ([],)}, "kinds"),
         (SeedConfig, {"time_budget": 0.0}, "time_budget"),
         (SeedConfig, {"time_budget": float("inf")}, "time_budget"),
         (IpoptConfig, {"interpolated": 100_000}, "interpolated"),

@@ -98,7 +98,7 @@ class SeedConfig:
         if not isinstance(self.kinds, tuple) or not self.kinds:
             raise InputError(f"kinds: expected a list of seed kind names, got {self.kinds!r}")
         for kind in self.kinds:
-            if kind not in SEED_KINDS:
+            if not isinstance(kind, str) or kind not in SEED_KINDS:
                 raise InputError(
                     f"kinds: unknown seed kind {kind!r}; choose from {list(SEED_KINDS)}"
                 )
