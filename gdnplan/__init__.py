@@ -45,7 +45,17 @@ if TYPE_CHECKING:  # what the lazy names are, for type checkers and IDEs
     from .models import CoalModel, DistanceModel, load_model
     from .robot import Robot, load_robot, robot_names
     from .scene import Scene, make_scene, scene_names
-    from .trajopt import Plan, Problem, TrajoptOptions, plan
+    from .trajopt import (
+        AdamConfig,
+        IpoptConfig,
+        Plan,
+        PlanConfig,
+        Problem,
+        RefineConfig,
+        SeedConfig,
+        TrajoptOptions,
+        plan,
+    )
     from .urdf_robot import RobotSpec, robot_from_urdf
 
 __version__ = version("gdnplan")
@@ -69,25 +79,35 @@ _LAZY = {  # public name -> the submodule defining it
     "Plan": "trajopt",
     "Problem": "trajopt",
     "TrajoptOptions": "trajopt",
+    "PlanConfig": "trajopt",
+    "SeedConfig": "trajopt",
+    "RefineConfig": "trajopt",
+    "IpoptConfig": "trajopt",
+    "AdamConfig": "trajopt",
     "plan": "trajopt",
     "RobotSpec": "urdf_robot",
     "robot_from_urdf": "urdf_robot",
 }
 
 __all__ = [
+    "AdamConfig",
     "CoalModel",
     "DistanceCallback",
     "DistanceModel",
     "GdnplanError",
     "InfeasibleProblemError",
     "InputError",
+    "IpoptConfig",
     "OutputError",
     "Plan",
+    "PlanConfig",
     "Problem",
     "ProblemFileError",
+    "RefineConfig",
     "Robot",
     "RobotSpec",
     "Scene",
+    "SeedConfig",
     "TrajoptOptions",
     "UnknownNameError",
     "certify_path",

@@ -136,13 +136,6 @@ def parse_vector(text: str, name: str) -> np.ndarray:
         raise InputError(f"{name}: expected numbers separated by commas, got {text!r}") from e
 
 
-def read_toml(path: Path) -> dict:
-    """Parse a TOML file; raises ProblemFileError (unreadable, not UTF-8, malformed, too deep)."""
-    from .trajopt import read_problem_file
-
-    return read_problem_file(path)
-
-
 def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
     """A scene from a problem file or shipped problem name (with its start q), or from a
     scene generator name."""
@@ -159,36 +152,29 @@ def scene_and_start(target: str, seed: int) -> tuple[Scene, np.ndarray | None]:
 
 
 def problem_scene_and_start(path: str | Path) -> tuple[Scene, np.ndarray | None]:
-    """The scene and ``[start] q`` of a problem file, checked as ``plan`` checks it.
+    """The scene and ``[start] q`` of a problem file, checked as ``plan`` checks it (the one
+    parser, :func:`gdnplan.trajopt.problem_tables`).
 
     A file with a ``[goal]`` passes every check of :meth:`Problem.from_config` except the
     feasibility ones (a start in collision is what ``show`` draws); a scene-only file (no
     ``[goal]``, ``[start]`` optional) the checks of its tables. ProblemFileError names the file.
     """
     from .assets import problem_file
-    from .scene import scene_from_config
-    from .trajopt import TOP_KEYS, Problem, _no_unknown, _vector
+    from .trajopt import Problem, _vector, problem_tables, read_problem_file
 
-    cfg = read_toml(path)
+    cfg = read_problem_file(path)
     folder = problem_file(path).parent  # relative paths in the file ([robot] urdf) start here
     try:
-        if "goal" in cfg:
+        tables = problem_tables(cfg, base_dir=folder, require_goal="goal" in cfg)
+        if tables.goal is not None:
             try:
-                Problem.from_config(cfg, base_dir=folder)
+                Problem.from_tables(tables)
             except InfeasibleProblemError:
                 pass
-        _no_unknown(cfg, TOP_KEYS, "top level")
-        try:
-            scene = scene_from_config(cfg, base_dir=folder)
-        except TypeError as e:
-            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
-        start = cfg.get("start")
-        if start is None:
-            return scene, None
-        if not isinstance(start, dict) or "q" not in start:
-            raise ProblemFileError("[start]: expected a table with q = [start joint angles]")
-        q = _vector(start["q"], scene.robot.dof, "start.q")
-        return scene, check_limits(scene.robot, q, "start.q")
+        if tables.start is None:
+            return tables.scene, None
+        q = _vector(tables.start, tables.scene.robot.dof, "start.q")
+        return tables.scene, check_limits(tables.scene.robot, q, "start.q")
     except GdnplanError as e:
         raise ProblemFileError(f"{path}: {e}") from e
 
@@ -235,9 +221,22 @@ def show(
 def plan_command(
     problem_file: str = typer.Argument(..., help=PROBLEM_HELP),
     collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
-    solver: str = typer.Option("ipopt", help="ipopt (direct transcription) or adam (paper)."),
+    solver: str = typer.Option(
+        None,
+        help="ipopt (direct transcription) or adam (paper); default: the problem file's "
+        "optimiser ([ipopt] or [adam] table), else ipopt.",
+    ),
     weights: str = typer.Option(None, help=WEIGHTS_HELP),
     seed: int = typer.Option(0, min=0, help="Seed of the sampling-based initial guesses."),
+    seeds: int = typer.Option(
+        None,
+        help="Seed paths refined (Ipopt), the cheapest certified path returned; default: the "
+        "file's [seed] count, else 1 (with --time-budget: as many as fit).",
+    ),
+    time_budget: float = typer.Option(
+        None,
+        help="Wall-time budget (s): return the cheapest certified path found when it ends.",
+    ),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
     animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
     threads: int = typer.Option(1, help=THREADS_HELP),
@@ -262,10 +261,11 @@ def plan_command(
 
         require_meshcat()
     problem = Problem.from_toml(problem_file)
+    config = plan_flags_config(problem, solver, seeds, time_budget)
     result = plan(
         problem,
         collision=collision,
-        solver=solver,
+        solver=config,
         weights=weights,
         seed=seed,
         max_acceleration=max_acceleration,
@@ -294,6 +294,31 @@ def plan_command(
         view_plan([(problem.scene, result.q)])
     if not result.success:
         raise typer.Exit(1)
+
+
+def plan_flags_config(problem, solver: str | None, seeds: int | None, time_budget: float | None):
+    """The PlanConfig of ``gdnplan plan``: the problem file's settings, with the optimiser
+    ``--solver`` names (the file's settings for it when the file is set up for it, else its
+    defaults) and ``--seeds`` / ``--time-budget`` over the file's ``[seed]`` table."""
+    from dataclasses import replace
+
+    from .trajopt import AdamConfig, PlanConfig
+    from .trajopt.config import OPTIMIZERS, with_optimizer
+
+    config = problem.solver or PlanConfig()
+    if solver is not None:  # the named optimiser, with the file's settings when they are its
+        if solver not in OPTIMIZERS:
+            raise InputError(f"--solver: unknown {solver!r}; choose ipopt or adam")
+        config = with_optimizer(config, solver)
+    if seeds is not None and isinstance(config.optimizer, AdamConfig):
+        raise InputError("--seeds: Adam starts from the straight line; seeds need --solver ipopt")
+    try:
+        count = config.seed.count if seeds is None else seeds
+        budget = config.seed.time_budget if time_budget is None else time_budget
+        config = replace(config, seed=replace(config.seed, count=count, time_budget=budget))
+    except InputError as e:
+        raise InputError(f"--seeds/--time-budget: {e}") from e
+    return config
 
 
 def clearance_text(lower_bound: float) -> str:
@@ -333,6 +358,8 @@ def plan_summary(result, joint_names: list[str]) -> dict:
         "status": result.status,
         "reason": result.reason,
         "path_cost": float(result.path_cost),
+        "seed": None if result.seed is None else result.seed.summary(),
+        "attempts": int(result.attempts),
     }
 
 

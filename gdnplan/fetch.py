@@ -27,7 +27,9 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +40,8 @@ from .errors import InfeasibleProblemError, InputError
 from .models import DistanceModel
 from .scene import Scene, make_scene
 from .timing import time_path, urdf_velocity
-from .trajopt import Plan, Problem, TrajoptOptions, plan, resolve_model
+from .trajopt import Plan, PlanConfig, Problem, plan, resolve_model
+from .trajopt.problem_file import plan_config_from_tables, read_problem_file
 from .ur5e import LIFT, analytic_ik
 
 log = logging.getLogger(__name__)  # one INFO line per finished stage
@@ -48,11 +51,28 @@ LIFT_POINTS = 11  # IK points on the lift line, 2 mm apart
 # the closed gripper's stick rests on its shelf (d = 0 by construction); coal's rounding gives
 # up to ≈ −4e-16 m there on some layouts, which is contact, not penetration
 RESTING_CONTACT_TOL = 1e-9  # m
-# bring-out threads the held stick through the entrance: the default RRT step (2 rad) found no
-# seed path; 0.3 rad steps do, given more than the default 5 s on a loaded 2-core machine. Three
-# check points per segment (Ipopt's default is 2): with 2 the certified path cost of
-# problems/fetch_bring_out.toml rose from 0.13 to 0.30 rad² (coal) and 0.17 (GraphDistNet)
-BRING_OUT_OPTIONS = TrajoptOptions(rrt_step=0.3, rrt_time=20.0, interpolated=3)
+BRING_OUT_PROBLEM = "fetch_bring_out"  # the shipped problem whose planner tables bring-out uses
+
+
+@cache
+def bring_out_config() -> PlanConfig:
+    """The bring-out stage's planner settings: the ``[seed]``/``[ipopt]`` tables of
+    ``problems/fetch_bring_out.toml`` (the held stick threads the entrance: short RRT-Connect
+    steps, a longer RRT time, three check points per segment; the file says why)."""
+    config = plan_config_from_tables(read_problem_file(BRING_OUT_PROBLEM))
+    assert config is not None, f"{BRING_OUT_PROBLEM}: no planner tables"
+    return config
+
+
+def __getattr__(name: str):
+    if name == "BRING_OUT_OPTIONS":
+        warnings.warn(
+            "gdnplan.fetch.BRING_OUT_OPTIONS is deprecated; use gdnplan.fetch.bring_out_config()",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return bring_out_config()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass(frozen=True)
@@ -112,7 +132,7 @@ def stage_problem(
     goal: np.ndarray,
     margin: float = 0.01,
     waypoints: int = 30,
-    solver: TrajoptOptions | None = None,
+    solver: PlanConfig | None = None,
 ) -> Problem:
     """A joint-space problem start → goal (3,) in ``scene`` with clearance ``margin`` (m) and
     the stage's own ``solver`` settings (None: the defaults)."""
@@ -220,7 +240,7 @@ def run_fetch(
             )
         elif name == "bring_out":
             problem = stage_problem(
-                held, info["q_lift"], info["q_out"], margin, solver=BRING_OUT_OPTIONS
+                held, info["q_lift"], info["q_out"], margin, solver=bring_out_config()
             )
             out.append(_planned(name, problem, collision, weights))
         elif name == "retreat":

@@ -13,16 +13,18 @@ import numpy as np
 from .errors import InputError
 
 MAX_WAYPOINTS = 500  # Problem.waypoints
-MAX_INTERPOLATED = 50  # TrajoptOptions.interpolated: check points inside one segment
+MAX_INTERPOLATED = 50  # IpoptConfig/AdamConfig.interpolated: check points inside one segment
 MAX_CHECK_POINTS = 20_000  # (waypoints − 1) · (interpolated + starts) of a first solve
 MAX_REFINE_ROUNDS = 8  # each doubles the check points of a rejected segment
-MAX_STARTS = 50
+MAX_STARTS = 50  # SeedConfig.starts
+MAX_SEEDS = 50  # SeedConfig.count: seed paths refined in one plan call
+MAX_TIME_BUDGET = 3600.0  # s, SeedConfig.time_budget of one plan call
 MAX_ITER = 10_000  # Ipopt iterations per attempt
 MAX_ADAM_ITERATIONS = 100_000
 MAX_RRT_TIME = 600.0  # s, one RRT-Connect run
 MAX_TIMED_SAMPLES = 1_000_000  # TimedTrajectory.sample: time samples of one call
 
-# Ipopt options a [solver] ipopt table may set: name -> float, int, or the allowed strings
+# Ipopt options an [ipopt.options] table may set: name -> float, int, or the allowed strings
 IPOPT_OPTIONS: dict[str, type | tuple[str, ...]] = {
     "tol": float,
     "acceptable_tol": float,

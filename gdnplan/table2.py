@@ -44,7 +44,8 @@ from .files import write_text
 from .models import CoalModel, DistanceModel, load_model
 from .rrt import rrt_connect
 from .scene import make_scene
-from .trajopt import Plan, Problem, TrajoptOptions, plan, straight_line
+from .trajopt import Plan, PlanConfig, Problem, TrajoptOptions, plan, straight_line
+from .trajopt.config import with_optimizer
 
 SETTINGS = ("b", "d", "fetch")
 METHODS = ("GraphDistNet", "ClearanceNet", "DiffCo", "coal")
@@ -170,7 +171,7 @@ def run_setting(
     problems: list[Problem],
     methods: Iterable[str] = METHODS,
     solvers: Iterable[str] = SOLVERS,
-    options: TrajoptOptions | None = None,
+    options: PlanConfig | TrajoptOptions | None = None,
     weights_dir: Path = WEIGHTS_DIR,
     log: Callable[[str], None] = print,
     first: int = 0,
@@ -196,7 +197,9 @@ def run_setting(
             model = factory(problem)  # DiffCo trains here, once for both solvers
             prep = time.perf_counter() - start if method == "DiffCo" else 0.0
             for solver in solvers:
-                r = plan(problem, collision=model, solver=solver, seed=i, options=options)
+                old = isinstance(options, TrajoptOptions)  # deprecated
+                base = options.to_config(solver) if old else options or PlanConfig()
+                r = plan(problem, collision=model, solver=with_optimizer(base, solver), seed=i)
                 records.append(_record(setting, method, solver, i, r, prep))
                 log(
                     f"{setting} #{i} {method}+{solver}: {'ok' if r.success else 'FAIL'} "

@@ -11,7 +11,7 @@ import gdnplan as gp
 from gdnplan.assets import problem_names
 from gdnplan.ccd import certify_path
 from gdnplan.cli import plan_summary
-from gdnplan.trajopt import Problem, TrajoptOptions, plan
+from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
 from gdnplan.trajopt.check_points import constraint_margin
 from gdnplan.trajopt.result import _finish, _Run
 
@@ -57,7 +57,7 @@ def test_clearance_zero_certifies_collision_freedom_only():
     assert result.success and result.clearance == 0.0 and result.min_distance > 0.0
     assert plan_summary(result, ["a", "b"])["clearance"] == 0.0
     # at clearance 0 the check points keep the margin; between them the path may dip below it
-    assert constraint_margin(zero, TrajoptOptions().clearance_buffer) == zero.margin
+    assert constraint_margin(zero, RefineConfig().clearance_buffer) == zero.margin
     # this path (what the old rule, a certificate of d > 0, accepted) dips below the margin:
     # certified at the margin, the default problem refuses it
     assert 0.0 < result.min_distance < default.margin
@@ -86,8 +86,10 @@ def test_clearance_equal_to_the_margin_is_the_default():
 
 def test_without_a_buffer_the_refine_rounds_still_never_accept_less_than_the_margin():
     problem = Problem.from_toml("planar7_d")
-    opts = TrajoptOptions(clearance_buffer=0.0, refine_rounds=1, starts=1, initial="rrt")
-    result = plan(problem, collision="coal", options=opts)
+    opts = PlanConfig(
+        SeedConfig(starts=1, initial="rrt"), RefineConfig(clearance_buffer=0.0, rounds=1)
+    )
+    result = plan(problem, collision="coal", solver=opts)
     # check points at exactly the margin: active rows end a hair inside it, so the
     # certificate at the margin rejects them; success, if any, is still proven
     assert not result.success or result.min_distance > problem.margin

@@ -110,9 +110,13 @@ def test_fetch_gives_up_after_max_tries(monkeypatch):
 
 
 def test_bring_out_problem_file_carries_the_fetch_stage_solver_settings():
-    from gdnplan.fetch import BRING_OUT_OPTIONS
+    from gdnplan import fetch
 
-    assert gp.Problem.from_toml(PROBLEMS / "fetch_bring_out.toml").solver == BRING_OUT_OPTIONS
+    config = fetch.bring_out_config()  # read from the problem file: one home
+    assert gp.Problem.from_toml(PROBLEMS / "fetch_bring_out.toml").solver == config
+    assert config.seed.rrt_step == 0.3 and config.optimizer.interpolated == 3
+    with pytest.warns(DeprecationWarning, match="bring_out_config"):
+        assert fetch.BRING_OUT_OPTIONS == config
     assert gp.Problem.from_toml(PROBLEMS / "fetch_reach.toml").solver is None
 
 
@@ -132,6 +136,13 @@ def test_bring_out_problem_file_plans_with_coal():
         ("[solver]\nstarts = 2.5", "starts: expected an integer"),
         ("[solver]\nipopt = 1", "ipopt: expected a table"),
         ("solver = 3", "expected a table"),
+        ("[seed]\nrrt_stepp = 0.3", "unknown key"),
+        ("[seed]\nrrt_step = 'short'", r"\[seed\] rrt_step: expected a number"),
+        ("[refine]\nccd = 1", r"\[refine\] ccd: expected true or false"),
+        ("[seed]\nstarts = 2.5", "starts: expected an integer"),
+        ("[ipopt]\noptions = 1", "options: expected a table"),
+        ("[ipopt]\nrrt_step = 0.3", r"belongs in \[seed\]"),
+        ("seed = 3", "expected a table"),
     ],
 )
 def test_bad_solver_table_is_a_problem_file_error(tmp_path, table, message):

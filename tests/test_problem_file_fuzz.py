@@ -62,6 +62,13 @@ FIELDS = [
     ("solver", "interpolated"),
     ("solver", "ipopt"),
     ("solver", "per_link"),
+    ("seed", "count"),
+    ("seed", "kinds"),
+    ("seed", "time_budget"),
+    ("refine", "rounds"),
+    ("ipopt", "interpolated"),
+    ("ipopt", "options"),
+    ("adam", "lr"),
 ]
 
 

@@ -1,3 +1,4 @@
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -8,8 +9,13 @@ from gdnplan import trajopt
 from gdnplan.ccd import certify_path, lever_arms, motion_bound, verify_path
 from gdnplan.models import CoalModel
 from gdnplan.trajopt import (
+    AdamConfig,
+    IpoptConfig,
     Plan,
+    PlanConfig,
     Problem,
+    RefineConfig,
+    SeedConfig,
     TrajoptOptions,
     _path_parameters,
     _Transcription,
@@ -46,8 +52,10 @@ def test_ipopt_solves_planar2_around_a_square_with_coal(square):
 
 def test_extra_ipopt_options_reach_the_solver(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
-    opts = TrajoptOptions(ccd=False, starts=1, ipopt={"max_iter": 2})
-    result = plan(p, collision="coal", options=opts)
+    cfg = PlanConfig(
+        SeedConfig(starts=1), RefineConfig(ccd=False), IpoptConfig(options={"max_iter": 2})
+    )
+    result = plan(p, collision="coal", solver=cfg)
     assert result.iterations == 2 and result.status == "Maximum_Iterations_Exceeded"
 
 
@@ -55,7 +63,7 @@ def test_refine_round_warm_start_keeps_the_multipliers_of_kept_check_points(squa
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=6)
     splits, refined = np.array([2, 2, 2, 2, 2]), np.array([2, 4, 2, 2, 2])
     np.testing.assert_array_equal(_path_parameters(splits)[:4], [0, 0.5, 1, 1.5])
-    opts = TrajoptOptions(per_link=False)
+    opts = IpoptConfig(per_link=False)
     nlp = _Transcription(p, CoalModel(), np.array(GOAL), opts, splits, p.margin)
     q, _ = nlp.solve(straight_line(np.array(START), np.array(GOAL), 6))
     lam_g, lam_x = nlp.duals_on(refined)
@@ -101,15 +109,17 @@ def test_goal_as_end_effector_position(square):
 
 def test_solver_failure_returns_unsuccessful_plan_with_reason(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
-    opts = TrajoptOptions(initial="straight", max_iter=1, ccd=False, starts=1)
-    result = plan(p, options=opts)
+    opts = PlanConfig(
+        SeedConfig(initial="straight", starts=1), RefineConfig(ccd=False), IpoptConfig(max_iter=1)
+    )
+    result = plan(p, solver=opts)
     assert not result.success
     assert "Maximum_Iterations_Exceeded" in result.reason and "not certified" in result.reason
 
 
 def test_adam_pushes_the_straight_line_out_of_the_square(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=20)
-    result = plan(p, solver="adam")
+    result = plan(p, solver=AdamConfig())
     assert result.success, result.reason
     assert result.status == "adam: cost below threshold" and result.iterations > 1
 
@@ -173,7 +183,7 @@ def test_adam_stops_with_a_learned_model_rating_the_goal_below_the_margin(square
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=20)
     model = GoalDip(GOAL)
     assert model.distance(square, np.array([GOAL]))[0] < 0  # no path has d̂ ≥ margin at the goal
-    result = plan(p, collision=model, solver="adam")
+    result = plan(p, collision=model, solver=AdamConfig())
     assert result.status == "adam: cost below threshold", result.reason
     assert result.success, result.reason
 
@@ -238,7 +248,7 @@ WEIGHTS_A = Path(__file__).resolve().parent.parent / "weights" / "a.safetensors"
 @pytest.mark.skipif(not WEIGHTS_A.exists(), reason="no GraphDistNet weights for env a")
 def test_ipopt_solves_planar2_around_a_square_with_graphdistnet(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=8)
-    result = plan(p, collision="graphdistnet", options=TrajoptOptions(interpolated=1))
+    result = plan(p, collision="graphdistnet", solver=IpoptConfig(interpolated=1))
     assert result.success, result.reason
     assert result.iterations > 0
     assert verify_path(square, result.q)[0]
@@ -268,8 +278,10 @@ class _BatchSizes:
 def test_check_points_per_segment_follow_the_solver_default(square, solver, interpolated, points):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     model = _BatchSizes()
-    opts = TrajoptOptions(interpolated=interpolated, initial="rrt", refine_rounds=0, starts=1)
-    plan(p, collision=model, solver=solver, options=opts)
+    kind = {"ipopt": IpoptConfig, "adam": AdamConfig}[solver]
+    optimizer = kind() if interpolated is None else kind(interpolated=interpolated)
+    opts = PlanConfig(SeedConfig(initial="rrt", starts=1), RefineConfig(rounds=0), optimizer)
+    plan(p, collision=model, solver=opts)
     inner = (p.waypoints - 1) * (points + 1) - 1  # Ipopt has no rows at start and goal
     assert model.sizes[-1] == (inner if solver == "ipopt" else inner + 2)
 
@@ -280,10 +292,13 @@ def test_negative_interpolated_or_raise_window_raises(square, initial):
     p = Problem(scene=square, start=START, goal=goal, waypoints=10)
     if initial == "auto":
         assert plan(p, collision="coal").status.startswith("straight line certified free")
-    with pytest.raises(gp.GdnplanError, match="interpolated"):
-        plan(p, collision="coal", options=TrajoptOptions(interpolated=-1, initial=initial))
-    with pytest.raises(gp.GdnplanError, match="raise_window"):
-        plan(p, collision="coal", options=TrajoptOptions(raise_window=-1, initial=initial))
+    seed = SeedConfig(initial=initial)
+    for config, name, field in ((IpoptConfig(), "interpolated", "optimizer"),
+                                (RefineConfig(), "raise_window", "refine")):  # fmt: skip
+        object.__setattr__(config, name, -1)  # forged past the config's own check
+        forged = replace(PlanConfig(seed=seed), **{field: config})
+        with pytest.raises(gp.GdnplanError, match=name):
+            plan(p, collision="coal", solver=forged)
 
 
 class _Liar(_BatchSizes):
@@ -301,8 +316,8 @@ class _Liar(_BatchSizes):
 def test_each_restart_adds_a_check_point_per_segment(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     model = _Liar()
-    opts = TrajoptOptions(initial="rrt", refine_rounds=0, starts=3)
-    result = plan(p, collision=model, options=opts)
+    opts = PlanConfig(SeedConfig(initial="rrt", starts=3), RefineConfig(rounds=0))
+    result = plan(p, collision=model, solver=opts)
     assert not result.success and result.attempts == 3
     batches = list(dict.fromkeys(model.sizes))  # distinct NLP sizes, in order
     assert batches[:3] == [(p.waypoints - 1) * (m + 1) - 1 for m in (2, 3, 4)]
@@ -329,10 +344,12 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
 
     monkeypatch.setattr(trajopt._Transcription, "__init__", record)
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
-    opts = TrajoptOptions(initial="rrt", refine_rounds=1, starts=1, raise_window=1)
-    assert not plan(p, collision=_Liar(), options=opts).success
+    opts = PlanConfig(SeedConfig(initial="rrt", starts=1), RefineConfig(rounds=1, raise_window=1))
+    assert not plan(p, collision=_Liar(), solver=opts).success
     (_, first), (splits, second) = margins
-    base = trajopt.check_points.constraint_margin(p, opts.clearance_buffer)  # margin + buffer
+    base = trajopt.check_points.constraint_margin(
+        p, opts.refine.clearance_buffer
+    )  # margin + buffer
     assert np.all(first == base)
     refined = np.flatnonzero(splits > splits.min())  # the segments coal rejected
     near = trajopt._near_segments(list(refined), len(splits), 1)
@@ -391,9 +408,50 @@ def test_refine_rounds_raise_to_the_overestimate_not_its_sum(square, monkeypatch
         ({"ipopt": []}, "ipopt"),
     ],
 )
-def test_trajopt_options_reject_bad_settings(settings, field):
+def test_deprecated_trajopt_options_reject_bad_settings(settings, field):
     with pytest.raises(gp.InputError, match=field):
         TrajoptOptions(**settings)
+
+
+@pytest.mark.parametrize(
+    ("config", "settings", "field"),
+    [
+        (RefineConfig, {"rounds": -1}, "rounds"),
+        (RefineConfig, {"rounds": 100}, "rounds"),
+        (AdamConfig, {"iterations": 0}, "iterations"),
+        (AdamConfig, {"lr": 0.0}, "lr"),
+        (AdamConfig, {"interpolated": -1}, "interpolated"),
+        (IpoptConfig, {"max_iter": -5}, "max_iter"),
+        (SeedConfig, {"starts": 0}, "starts"),
+        (SeedConfig, {"count": 0}, "count"),
+        (SeedConfig, {"count": 51}, "count"),
+        (SeedConfig, {"kinds": ("nope",)}, "kinds"),
+        (SeedConfig, {"kinds": ()}, "kinds"),
+        (SeedConfig, {"kinds": ([],)}, "kinds"),
+        (SeedConfig, {"time_budget": 0.0}, "time_budget"),
+        (SeedConfig, {"time_budget": float("inf")}, "time_budget"),
+        (IpoptConfig, {"interpolated": 100_000}, "interpolated"),
+        (IpoptConfig, {"interpolated": None}, "interpolated"),
+        (IpoptConfig, {"per_link": "yes"}, "per_link"),
+        (RefineConfig, {"raise_window": 1.5}, "raise_window"),
+        (IpoptConfig, {"tol": float("nan")}, "tol"),
+        (SeedConfig, {"rrt_clearance": float("nan")}, "rrt_clearance"),
+        (RefineConfig, {"clearance_buffer": -0.001}, "clearance_buffer"),
+        (IpoptConfig, {"link_cap": -1.0}, "link_cap"),
+        (SeedConfig, {"rrt_time": -1.0}, "rrt_time"),
+        (SeedConfig, {"rrt_step": 0.0}, "rrt_step"),
+        (RefineConfig, {"ccd": 1}, "ccd"),
+        (SeedConfig, {"initial": "nope"}, "initial"),
+        (IpoptConfig, {"options": {"no_such_option": 1}}, "no_such_option"),
+        (IpoptConfig, {"options": {"mu_strategy": "fast"}}, "mu_strategy"),
+        (IpoptConfig, {"options": []}, "ipopt"),
+        (PlanConfig, {"optimizer": "ipopt"}, "optimizer"),
+        (PlanConfig, {"seed": RefineConfig()}, "seed"),
+    ],
+)
+def test_configs_reject_bad_settings(config, settings, field):
+    with pytest.raises(gp.InputError, match=field):
+        config(**settings)
 
 
 def _cfg(**tables) -> dict:
@@ -421,7 +479,20 @@ def _cfg(**tables) -> dict:
         ({"solver": {"per_link": "yes"}}, "per_link"),
         ({"solver": {"refine_rounds": -1}}, "refine_rounds"),
         ({"solver": {"ipopt": {"foo": 1}}}, "foo"),
-        ({"solver": {"interpolated": 50, "starts": 50}, "options": {"waypoints": 500}}, None),
+        ({"solver": {"learned_margin": 0.01}}, "learned_margin"),
+        ({"solver": {"starts": 2}, "seed": {"starts": 3}}, "starts"),
+        ({"ipopt": {"per_link": "yes"}}, "per_link"),
+        ({"refine": {"rounds": -1}}, "rounds"),
+        ({"ipopt": {"options": {"foo": 1}}}, "foo"),
+        ({"seed": {"max_iter": 3}}, r"max_iter: not a \[seed\] key; it belongs in \[ipopt\]"),
+        ({"solver": {"rounds": 3}}, r"belongs in \[refine\]"),
+        ({"ipopt": {}, "adam": {}}, "at most one"),
+        ({"seed": {"kinds": "rrt"}}, "kinds: expected a list"),
+        ({"seed": {"time_budget": -1.0}}, "time_budget"),
+        (
+            {"ipopt": {"interpolated": 50}, "seed": {"starts": 50}, "options": {"waypoints": 500}},
+            None,
+        ),
     ],
 )
 def test_problem_config_rejects_bad_values_as_problem_file_errors(tables, field):
@@ -443,3 +514,34 @@ def test_unreadable_problem_files_are_problem_file_errors(tmp_path, text):
     path.write_bytes(text)
     with pytest.raises(gp.ProblemFileError):
         Problem.from_toml(path)
+
+
+def test_deprecated_names_warn_naming_the_new_ones_and_plan_the_same(square):
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    with pytest.warns(DeprecationWarning, match="PlanConfig"):
+        old = TrajoptOptions(refine_rounds=1, adam_lr=0.02, interpolated=1)
+    assert old.to_config("adam") == PlanConfig(
+        refine=RefineConfig(rounds=1), optimizer=AdamConfig(lr=0.02, interpolated=1)
+    )
+    with pytest.warns(DeprecationWarning, match="solver=gdnplan.PlanConfig"):
+        via_old = plan(p, collision="coal", options=old)
+    new = plan(p, collision="coal", solver=old.to_config("ipopt"))
+    np.testing.assert_array_equal(via_old.q, new.q)
+    with pytest.warns(DeprecationWarning, match=r"solver=gdnplan.AdamConfig\(\)"):
+        adam = plan(p, collision="coal", solver="adam")
+    np.testing.assert_array_equal(adam.q, plan(p, collision="coal", solver=AdamConfig()).q)
+    with pytest.warns(DeprecationWarning, match="IpoptConfig"):
+        plan(p, collision="coal", solver="ipopt")
+    with pytest.raises(gp.InputError, match="learned_margin"), pytest.warns(DeprecationWarning):
+        TrajoptOptions(learned_margin=0.01).to_config()
+
+
+def test_old_solver_table_loads_into_the_new_configs_with_a_warning():
+    old = _cfg(solver={"rrt_step": 0.3, "refine_rounds": 2, "interpolated": 3, "ipopt": {}})
+    with pytest.warns(DeprecationWarning, match=r"refine_rounds → \[refine\] rounds"):
+        problem = Problem.from_config(old)
+    new = _cfg(seed={"rrt_step": 0.3}, refine={"rounds": 2}, ipopt={"interpolated": 3})
+    assert problem.solver == Problem.from_config(new).solver
+    with pytest.warns(DeprecationWarning):
+        adam = Problem.from_config(_cfg(solver={"adam_lr": 0.02, "interpolated": 2}))
+    assert adam.solver.optimizer == AdamConfig(lr=0.02, interpolated=2)

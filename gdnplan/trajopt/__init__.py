@@ -28,7 +28,10 @@ rounds.
 dropped: at 3 check points per segment δ reaches ~1 m on seed paths, the rows are infeasible
 and Ipopt runs to its iteration cap.) Ipopt uses a limited-memory Hessian and starts from the
 straight line when it is certified free (then it is already optimal and returned as is) or
-from RRT-Connect seeds, restarting from a new seed on failure. A plan succeeds only when
+from seed paths (:mod:`gdnplan.trajopt.seeds`: RRT-Connect, a via point, or any registered
+kind), replacing a seed whose path ends uncertified; with ``SeedConfig.count`` > 1 (or a
+``time_budget``) it refines several seeds and returns the certified path of least path cost.
+A plan succeeds only when
 :func:`gdnplan.ccd.certify_path` proves with coal that the whole returned path keeps d > c
 (``Plan.min_distance`` is that proven bound) and the goal is reached — never on the solver's
 word alone.
@@ -40,26 +43,33 @@ from __future__ import annotations
 from ..ccd import verify_path
 from .adam import collision_cost
 from .check_points import distance_bounds, model_overestimate, straight_line
+from .config import (
+    CONFIG_TABLES,
+    INITIAL_GUESSES,
+    AdamConfig,
+    IpoptConfig,
+    PlanConfig,
+    RefineConfig,
+    SeedConfig,
+)
 from .ik import first_joint_barrier, tip_point, tip_position, tip_reach
 from .ipopt import SOLVER_ERRORS
-from .options import (
-    ADAM_INTERPOLATED,
-    INITIAL_GUESSES,
-    IPOPT_INTERPOLATED,
-    SOLVER_KEYS,
-    TrajoptOptions,
-)
-from .planner import checked, numeric_ik, plan, resolve_model
+from .options import ADAM_INTERPOLATED, IPOPT_INTERPOLATED, OLD_KEYS, SOLVER_KEYS, TrajoptOptions
+from .planner import checked, numeric_ik, plan, plan_config, resolve_model
 from .problem import Problem
 from .problem_file import (
+    CONFIG_KEYS,
     GOAL_KEYS,
     OPTION_KEYS,
     START_KEYS,
     TOP_KEYS,
+    ProblemTables,
     problem_start,
+    problem_tables,
     read_problem_file,
 )
 from .result import Plan, path_cost
+from .seeds import SEED_KINDS, SeedInfo, SeedRequest, register_seed_kind
 from .transcription import WARM_START_OPTIONS
 
 # private helpers that cli.py and tests/test_trajopt.py import from here
@@ -68,8 +78,15 @@ from .problem_file import _no_unknown, _vector  # isort: skip
 from .transcription import _Transcription  # isort: skip
 
 __all__ = [
+    "AdamConfig",
+    "IpoptConfig",
     "Plan",
+    "PlanConfig",
     "Problem",
+    "RefineConfig",
+    "SeedConfig",
+    "SeedInfo",
+    "SeedRequest",
     "TrajoptOptions",
     "collision_cost",
     "distance_bounds",
@@ -77,6 +94,8 @@ __all__ = [
     "numeric_ik",
     "path_cost",
     "plan",
+    "plan_config",
+    "register_seed_kind",
     "straight_line",
     "tip_position",
     "verify_path",

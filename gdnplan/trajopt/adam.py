@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 
 import numpy as np
 
 from ..ccd import certify_path
 from ..models import DistanceModel
 from .check_points import _interpolation_matrix, distance_bounds, straight_line
-from .options import ADAM_INTERPOLATED, _interpolated
+from .config import PlanConfig
 from .problem import Problem
 from .result import _Run
+from .seeds import SeedInfo
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
@@ -33,44 +35,64 @@ def collision_cost(
     return cost, dcost
 
 
-def _plan_adam(problem: Problem, model: DistanceModel, goal: np.ndarray, opts) -> _Run:
+def _plan_adam(
+    problem: Problem,
+    model: DistanceModel,
+    goal: np.ndarray,
+    cfg: PlanConfig,
+    seed: int = 0,
+    deadline: float = math.inf,
+) -> _Run:
     """Adam on the interior waypoints of Σ_k C(d(p_k)) + Σ_t ‖q_{t+1} − q_t‖², from the
     straight line, until the collision cost falls below the threshold — every term below
     C(margin + adam_stop), i.e. min_k d(p_k) ≥ margin + adam_stop as C decreases above the
     margin — or the iteration cap. With ``ccd``, reaching the threshold triggers the continuous
     certificate; uncertified segments get twice the check points and Adam continues. The
     margin of each check point is that of :func:`distance_bounds` (relaxed next to an endpoint
-    a learned model rates below the margin)."""
+    a learned model rates below the margin). It stops at ``deadline`` (a
+    :func:`time.perf_counter` value) too; the certificate judges the path it has then."""
+    opts, refine = cfg.optimizer, cfg.refine
     T = problem.waypoints
-    splits = np.full(T - 1, _interpolated(opts, ADAM_INTERPOLATED) + 1)
+    splits = np.full(T - 1, opts.interpolated + 1)
     W = _interpolation_matrix(splits)
-    slack = opts.adam_stop + 0.005  # the fixed endpoints must pass the stop test
+    slack = opts.stop + 0.005  # the fixed endpoints must pass the stop test
     lower = distance_bounds(problem, model, goal, splits, problem.margin, slack)
     q = straight_line(problem.start, goal, T)
     m, v = np.zeros_like(q), np.zeros_like(q)
     b1, b2 = 0.9, 0.999
     calls, refinements, status = 0, 0, "adam: iteration cap"
-    for it in range(1, opts.adam_iterations + 1):
+    for it in range(1, opts.iterations + 1):
+        if time.perf_counter() >= deadline:
+            status = "adam: time budget ended"
+            break
         d, g = model.distance_and_grad(problem.scene, W @ q)
         calls += 1
-        if np.all(d >= lower + opts.adam_stop):
+        if np.all(d >= lower + opts.stop):
             clearance = problem.certified_clearance
-            cert = certify_path(problem.scene, q, clearance) if opts.ccd else None
-            if cert is None or cert.ok or refinements == opts.refine_rounds:
+            cert = certify_path(problem.scene, q, clearance) if refine.ccd else None
+            if cert is None or cert.ok or refinements == refine.rounds:
                 status = "adam: cost below threshold"
                 break
             splits[list(cert.bad_segments)] *= 2
             W, refinements = _interpolation_matrix(splits), refinements + 1
             lower = distance_bounds(problem, model, goal, splits, problem.margin, slack)
             continue
-        _, dc = collision_cost(np.asarray(d), lower, opts.adam_c, opts.adam_eps)
+        _, dc = collision_cost(np.asarray(d), lower, opts.c, opts.eps)
         grad = W.T @ (dc[:, None] * g)
         grad[1:] += 2 * (q[1:] - q[:-1])
         grad[:-1] -= 2 * (q[1:] - q[:-1])
         grad[[0, -1]] = 0.0
         m = b1 * m + (1 - b1) * grad
         v = b2 * v + (1 - b2) * grad**2
-        step = opts.adam_lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
+        step = opts.lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
         q = np.clip(q - step, problem.lower, problem.upper)
     log.info("solve: %s, %d iterations", status, it)
-    return _Run(q=q, iterations=it, status=status, reason=status, model_calls=calls, attempts=1)
+    return _Run(
+        q=q,
+        iterations=it,
+        status=status,
+        reason=status,
+        model_calls=calls,
+        attempts=1,
+        seed=SeedInfo("straight", 0, seed),
+    )

@@ -1,12 +1,13 @@
-"""The Ipopt solver: the straight line when it is certified free, else one seed per attempt
-(RRT-Connect or a perturbed straight line), each solved, certified and refined in rounds
-(:func:`_solve_refined`)."""
+"""The Ipopt optimiser: the straight line when it is certified free, else seed paths
+(:mod:`gdnplan.trajopt.seeds`), each solved, certified and refined in rounds
+(:func:`_solve_refined`); the certified path of least path cost is returned."""
 
 from __future__ import annotations
 
 import logging
+import math
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -14,7 +15,6 @@ from ..casadi_bridge import supports_per_link
 from ..ccd import certify_path
 from ..distance import signed_distance
 from ..models import CoalModel, DistanceModel
-from ..rrt import seed_path
 from .check_points import (
     _check_point_raise,
     _near_segments,
@@ -22,50 +22,15 @@ from .check_points import (
     model_overestimate,
     straight_line,
 )
-from .options import IPOPT_INTERPOLATED, TrajoptOptions, _count, _interpolated
+from .config import PlanConfig
 from .problem import Problem
-from .result import _Run
+from .result import _Run, path_cost
+from .seeds import SeedInfo, draw_seed
 from .transcription import _Transcription
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
 SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
-
-
-def _seeds(problem: Problem, goal: np.ndarray, opts: TrajoptOptions, seed: int):
-    """Yield (label, initial guess (T, dof) or None when RRT-Connect failed) per attempt."""
-    line = straight_line(problem.start, goal, problem.waypoints)
-    use_line = opts.initial == "straight"
-    rng = np.random.default_rng(seed)
-    # seed edges must clear margin + rrt_clearance, but never more than the ends allow
-    ends = float(np.min(signed_distance(problem.scene, np.stack([problem.start, goal]))))
-    clearance = problem.margin + min(opts.rrt_clearance, (ends - problem.margin) / 2)
-    for attempt in range(opts.starts):
-        if use_line:
-            guess = line.copy()
-            if attempt:  # restarts perturb the interior waypoints by N(0, 0.2 rad)
-                guess[1:-1] += rng.normal(0, 0.2, guess[1:-1].shape)
-                guess = np.clip(guess, problem.lower, problem.upper)
-            yield "straight line" + (f" (perturbed {attempt})" if attempt else ""), guess
-            continue
-        label = f"RRT-Connect seed {seed + attempt}"
-        t0 = time.perf_counter()
-        for demand in dict.fromkeys((clearance, problem.margin)):  # narrow passage: margin only
-            guess, _ = seed_path(
-                problem.scene,
-                problem.start,
-                goal,
-                problem.waypoints,
-                demand,
-                seed=seed + attempt,
-                time_limit=opts.rrt_time,
-                step=opts.rrt_step,
-            )
-            if guess is not None:
-                break
-        found = "path found" if guess is not None else "no path"
-        log.info("seed: %s: %s, %.2f s", label, found, time.perf_counter() - t0)
-        yield label + (" (clearance = margin)" if demand < clearance else ""), guess
 
 
 def _line_free(problem: Problem, line: np.ndarray) -> bool:
@@ -75,76 +40,134 @@ def _line_free(problem: Problem, line: np.ndarray) -> bool:
     return certify_path(problem.scene, line, problem.margin, tol=np.inf, stop_early=True).ok
 
 
-def _plan_ipopt(problem: Problem, model: DistanceModel, goal: np.ndarray, opts, seed: int) -> _Run:
-    """Straight line when certified free, else Ipopt from one seed per attempt.
+def _seed_clearance(problem: Problem, goal: np.ndarray, extra: float) -> float:
+    """Seed edges clear margin + extra, but never more than half the ends' own spare room."""
+    ends = float(np.min(signed_distance(problem.scene, np.stack([problem.start, goal]))))
+    return problem.margin + min(extra, (ends - problem.margin) / 2)
 
-    An attempt that ends uncertified suggests check points too sparse for the problem, so
-    attempt a (0-based) starts with ``interpolated + a`` check points per segment: on one (d)
-    problem (#14, two torch threads) all three attempts with 2 check points ended uncertified
-    (the path slipped through an obstacle between them), a second attempt with 3 succeeded.
+
+@dataclass
+class _Best:
+    """The certified path of least path cost so far."""
+
+    q: np.ndarray | None = None
+    cost: float = math.inf
+    label: str = ""
+    status: str = ""
+    info: SeedInfo | None = None
+    cert: object = None
+    certified: int = 0
+
+
+def _plan_ipopt(
+    problem: Problem,
+    model: DistanceModel,
+    goal: np.ndarray,
+    cfg: PlanConfig,
+    seed: int,
+    deadline: float = math.inf,
+) -> _Run:
+    """Straight line when certified free, else Ipopt from each seed; the cheapest certified.
+
+    Seeds i = 0, 1, … (kind ``kinds[i % len(kinds)]``, stream seed + i) are refined until
+    ``seed_count`` are certified, ``starts`` have ended uncertified, or the clock passes
+    ``deadline``. An attempt that ends uncertified suggests check points too sparse for the
+    problem, so after f such attempts a seed starts with ``interpolated + min(f, starts − 1)``
+    check points per segment (on one (d) problem, #14, all three attempts with 2 check points
+    ended uncertified, the path slipping through an obstacle between them; with 3 it succeeded).
     """
-    first = _interpolated(opts, IPOPT_INTERPOLATED)  # bad input fails even on a free line
-    if opts.raise_window is not None:
-        _count(opts.raise_window, "raise_window")
+    sc = cfg.seed
     line = straight_line(problem.start, goal, problem.waypoints)
-    if opts.initial == "auto" and _line_free(problem, line):
+    if sc.initial == "auto" and _line_free(problem, line):
         status = "straight line certified free (optimal path cost, no solve needed)"
         log.info("seed: %s", status)
-        return _Run(q=line, status=status, reason=status)
-    run = _Run(q=line)
-    for attempt, (label, guess) in enumerate(_seeds(problem, goal, opts, seed)):
+        return _Run(q=line, status=status, reason=status, seed=SeedInfo("straight", 0, seed))
+    clearance = _seed_clearance(problem, goal, sc.rrt_clearance)
+    run, best, failures = _Run(q=line), _Best(), 0
+    first, wanted = cfg.optimizer.interpolated, sc.seed_count
+    for index in range(wanted + sc.starts - 1):
+        if best.certified == wanted or failures == sc.starts:
+            break
+        if time.perf_counter() >= deadline:
+            run.reason = f"{run.reason}; time budget ended".lstrip("; ")
+            break
+        kind = "straight" if sc.initial == "straight" else sc.kinds[index % len(sc.kinds)]
+        rrt = (sc.rrt_time, sc.rrt_step)
+        guess, label = draw_seed(kind, problem, goal, clearance, seed, index, rrt, deadline)
         run.attempts += 1
         if guess is None:
-            run.reason = f"{run.reason}; {label}: RRT-Connect found no path".lstrip("; ")
+            run.reason = f"{run.reason}; {label}: no seed path".lstrip("; ")
+            failures += 1
             continue
-        if attempt:
-            label = f"{label}, {first + attempt} check points per segment"
-        attempt_opts = replace(opts, interpolated=first + attempt)
-        q, stats, ok = _solve_refined(problem, model, goal, attempt_opts, guess, run)
-        run.q, run.status = q, stats.get("return_status", "exception")
-        if ok:
-            run.reason = f"{label}: {run.status}"
-            break
-        run.reason = f"{run.reason}; {label}: {run.status}, path not certified".lstrip("; ")
+        extra = min(failures, sc.starts - 1)
+        if extra:
+            label = f"{label}, {first + extra} check points per segment"
+        attempt = replace(cfg, optimizer=replace(cfg.optimizer, interpolated=first + extra))
+        q, stats, ok = _solve_refined(problem, model, goal, attempt, guess, run, deadline)
+        status = stats.get("return_status", "exception")
+        if not ok:
+            failures += 1
+            run.q, run.status = q, status
+            run.reason = f"{run.reason}; {label}: {status}, path not certified".lstrip("; ")
+            continue
+        best.certified += 1
+        cost = path_cost(q)
+        log.info("seed: %s certified, path cost %.4f rad²", label, cost)
+        if cost < best.cost:
+            info = SeedInfo(kind, index, seed + index)
+            best = replace(best, q=q, cost=cost, label=label, status=status, info=info)
+            best.cert = run.verified
+    if best.q is not None:
+        run.q, run.status, run.verified, run.seed = best.q, best.status, best.cert, best.info
+        of = f" (least path cost of {best.certified} certified)" if best.certified > 1 else ""
+        run.reason = f"{best.label}: {best.status}{of}"
     return run
 
 
-def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: _Run):
+def _solve_refined(
+    problem: Problem,
+    model,
+    goal,
+    cfg: PlanConfig,
+    guess: np.ndarray,
+    run: _Run,
+    deadline: float = math.inf,
+):
     """Solve, certify, refine, re-solve: (q, last stats, certified).
 
     The check points demand d ≥ :func:`constraint_margin` (the margin, or the certified
-    clearance + ``opts.clearance_buffer`` if that is more); the certificate must prove
+    clearance + ``clearance_buffer`` if that is more); the certificate must prove
     d > ``problem.certified_clearance`` on the whole continuous path.
     Each round that the coal certificate rejects doubles the check points of the rejected
     segments and, for a learned model, raises the constraint margin to the model's observed
     overestimate there (:func:`model_overestimate`) on the rejected segments and
-    ``opts.raise_window`` segments either side: the learned constraint then keeps the path
-    away from the contact coal found, whatever the model's error. (On the rejected segments
-    alone, the contact moved to the neighbouring segments of the (d) problems and 2 of 6
-    needed a second seed; on the whole path, a narrow passage elsewhere closed: the fetch
-    bring-out's entrance.)
-    With ``warm_start`` a refine round starts from the last round's multipliers
-    (:meth:`_Transcription.duals_on`): on three (d) problems with one-way GraphDistNet weights
-    the second rounds took 36, 61 and 13 Ipopt iterations instead of 53, 130 and 85.
+    ``raise_window`` segments either side: the learned constraint then keeps the path away
+    from the contact coal found, whatever the model's error (on the rejected segments alone
+    the contact moved to the neighbouring segments; on the whole path a narrow passage
+    elsewhere closed). With ``warm_start`` a refine round starts from the last round's
+    multipliers (:meth:`_Transcription.duals_on`). Before ``deadline`` (a
+    :func:`time.perf_counter` value) Ipopt gets the time left as ``max_wall_time``; no round
+    starts after it.
     """
-    splits = np.full(problem.waypoints - 1, opts.interpolated + 1)  # set by _plan_ipopt
-    per_link = supports_per_link(model) if opts.per_link is None else opts.per_link
+    ipopt, refine = cfg.optimizer, cfg.refine
+    splits = np.full(problem.waypoints - 1, ipopt.interpolated + 1)
+    per_link = supports_per_link(model) if ipopt.per_link is None else ipopt.per_link
+    ipopt = replace(ipopt, per_link=per_link)
     learned = not isinstance(model, CoalModel)
-    base = constraint_margin(problem, opts.clearance_buffer)  # above the certified clearance
-    margin = base + (opts.learned_margin if learned else 0.0)
+    margin = constraint_margin(problem, refine.clearance_buffer)  # above the certified clearance
     raised = np.zeros(len(splits))  # margin raise of each segment (m)
-    q, duals = guess, None
-    for round_ in range(1 + (opts.refine_rounds if opts.ccd else 0)):
+    q, duals, stats = guess, None, {"return_status": "time budget ended"}
+    for round_ in range(1 + (refine.rounds if refine.ccd else 0)):
         t0 = time.perf_counter()
+        if t0 >= deadline:
+            break
+        if math.isfinite(deadline):
+            left = min(max(deadline - t0, 1e-3), ipopt.options.get("max_wall_time", math.inf))
+            ipopt = replace(ipopt, options={**ipopt.options, "max_wall_time": left})
         nlp = _Transcription(
-            problem,
-            model,
-            goal,
-            replace(opts, per_link=per_link),
-            splits,
-            margin + _check_point_raise(splits, raised),
+            problem, model, goal, ipopt, splits, margin + _check_point_raise(splits, raised),
             duals is not None,
-        )
+        )  # fmt: skip
         q, stats = nlp.solve(q, duals)
         run.iterations += stats.get("iter_count", 0)
         run.model_calls += nlp.callback.model_calls
@@ -162,10 +185,10 @@ def _solve_refined(problem: Problem, model, goal, opts, guess: np.ndarray, run: 
         log.info("certify: %d segment(s) not proven clear (more check points there)", len(bad))
         refined = splits.copy()
         refined[bad] *= 2
-        duals = nlp.duals_on(refined) if opts.warm_start else None
+        duals = nlp.duals_on(refined) if refine.warm_start else None
         splits = refined
         if learned:
-            over = model_overestimate(problem.scene, model, q, bad, base)
-            near = _near_segments(bad, len(splits), opts.raise_window)  # active rows sit at
+            over = model_overestimate(problem.scene, model, q, bad, margin)
+            near = _near_segments(bad, len(splits), refine.raise_window)  # active rows sit at
             raised[near] = np.maximum(raised[near], over)  # d̂ = bound: raise to the error, no sum
     return q, stats, False

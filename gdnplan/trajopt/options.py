@@ -1,8 +1,10 @@
-"""Solver settings: :class:`TrajoptOptions`, checked when made, and the check points per
-segment each solver starts with."""
+"""The deprecated option bag :class:`TrajoptOptions` (use the configs of
+:mod:`gdnplan.trajopt.config`) and where each of its fields lives now (:data:`OLD_KEYS`, also
+the map of a problem file's old ``[solver]`` table)."""
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, fields
 
 from ..errors import InputError
@@ -18,14 +20,53 @@ from ..limits import (
     check_ipopt,
     check_number,
 )
+from .config import (
+    INITIAL_GUESSES,
+    AdamConfig,
+    IpoptConfig,
+    PlanConfig,
+    RefineConfig,
+    SeedConfig,
+)
 
-INITIAL_GUESSES = ("auto", "straight", "rrt")
-IPOPT_INTERPOLATED, ADAM_INTERPOLATED = 2, 3  # TrajoptOptions.interpolated=None per solver
+IPOPT_INTERPOLATED, ADAM_INTERPOLATED = IpoptConfig.interpolated, AdamConfig.interpolated
+REMOVED = "removed (no shipped default, problem, benchmark or weights used it)"
+# old field -> (problem-file table, key there) of its new home; None: removed
+OLD_KEYS: dict[str, tuple[str, str] | None] = {
+    "initial": ("seed", "initial"),
+    "starts": ("seed", "starts"),
+    "rrt_clearance": ("seed", "rrt_clearance"),
+    "rrt_time": ("seed", "rrt_time"),
+    "rrt_step": ("seed", "rrt_step"),
+    "ccd": ("refine", "ccd"),
+    "refine_rounds": ("refine", "rounds"),
+    "warm_start": ("refine", "warm_start"),
+    "clearance_buffer": ("refine", "clearance_buffer"),
+    "raise_window": ("refine", "raise_window"),
+    "interpolated": ("ipopt", "interpolated"),  # or [adam]'s, for the Adam optimiser
+    "per_link": ("ipopt", "per_link"),
+    "link_cap": ("ipopt", "link_cap"),
+    "max_iter": ("ipopt", "max_iter"),
+    "tol": ("ipopt", "tol"),
+    "obj_change_tol": ("ipopt", "obj_change_tol"),
+    "ipopt": ("ipopt", "options"),
+    "adam_iterations": ("adam", "iterations"),
+    "adam_lr": ("adam", "lr"),
+    "adam_c": ("adam", "c"),
+    "adam_eps": ("adam", "eps"),
+    "adam_stop": ("adam", "stop"),
+    "learned_margin": None,
+}
 
 
 @dataclass(frozen=True)
 class TrajoptOptions:
-    """Solver settings (defaults are the benchmarked configuration), checked when made:
+    """Deprecated: use :class:`~gdnplan.trajopt.config.SeedConfig`, ``RefineConfig``,
+    ``IpoptConfig`` and ``AdamConfig`` (in a :class:`~gdnplan.trajopt.config.PlanConfig`);
+    :meth:`to_config` converts, :data:`OLD_KEYS` says where each field went. Making one warns
+    (DeprecationWarning). ``learned_margin`` is removed: only 0 is accepted by :meth:`to_config`.
+
+    Solver settings, checked when made:
     a wrong type, NaN/inf or a value past its limit (:mod:`gdnplan.limits`: refine_rounds ≤ 8,
     interpolated ≤ 50, 1 ≤ starts ≤ 50, 1 ≤ max_iter ≤ 10 000, 1 ≤ adam_iterations ≤ 100 000,
     0 < rrt_time ≤ 600 s, ipopt options from an allow-list) is an InputError.
@@ -59,8 +100,7 @@ class TrajoptOptions:
             default): Ipopt leaves active check points a hair inside their bound (d ≈ bound −
             1e-8), which a certificate at exactly that bound rejects as a configuration within
             it, and the buffer also leaves the path room to bend between check points.
-        learned_margin: extra constraint margin (m) for learned models in the first solve;
-            later rounds add the overestimate coal finds (see ``_solve_refined``).
+        learned_margin: removed; must be 0.
         raise_window: a refine round raises a learned model's margin on the rejected
             segments and this many segments either side of each; None: on the whole path.
             2 rather than the whole path: the fetch bring-out (one attempt, seeds 0–3)
@@ -131,18 +171,30 @@ class TrajoptOptions:
         if check_number(self.rrt_time, "rrt_time", strict=True) > MAX_RRT_TIME:
             raise InputError(f"rrt_time: {self.rrt_time} s is over the limit {MAX_RRT_TIME} s")
         check_ipopt(self.ipopt)
+        warnings.warn(
+            "TrajoptOptions is deprecated; use gdnplan.PlanConfig(seed=SeedConfig(...), "
+            "refine=RefineConfig(...), optimizer=IpoptConfig(...) or AdamConfig(...))",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+
+    def to_config(self, solver: str = "ipopt") -> PlanConfig:
+        """The same settings as a PlanConfig whose optimiser is ``solver`` ("ipopt"/"adam")."""
+        if self.learned_margin != 0:
+            raise InputError(f"learned_margin: {REMOVED}; leave it out")
+        tables: dict[str, dict] = {"seed": {}, "refine": {}, "ipopt": {}, "adam": {}}
+        for name, home in OLD_KEYS.items():
+            value = getattr(self, name)
+            if home is not None and (name != "interpolated" or value is not None):
+                tables[home[0]][home[1]] = value
+        if self.interpolated is not None:
+            tables["adam"]["interpolated"] = self.interpolated
+        if solver not in ("ipopt", "adam"):
+            raise InputError(f"solver: unknown {solver!r}; choose 'ipopt' or 'adam'")
+        optimizer = (
+            IpoptConfig(**tables["ipopt"]) if solver == "ipopt" else AdamConfig(**tables["adam"])
+        )
+        return PlanConfig(SeedConfig(**tables["seed"]), RefineConfig(**tables["refine"]), optimizer)
 
 
-SOLVER_KEYS = frozenset(f.name for f in fields(TrajoptOptions))  # a problem file's [solver]
-
-
-def _interpolated(opts: TrajoptOptions, default: int) -> int:
-    """Check points strictly inside each segment: ``opts.interpolated`` or the solver's default."""
-    return _count(default if opts.interpolated is None else opts.interpolated, "interpolated")
-
-
-def _count(value, name: str) -> int:
-    """``value`` if it is an integer ≥ 0, else InputError naming the option."""
-    if not isinstance(value, int) or value < 0:
-        raise InputError(f"{name}: expected an integer ≥ 0 or None, got {value!r}")
-    return value
+SOLVER_KEYS = frozenset(f.name for f in fields(TrajoptOptions))  # an old [solver] table

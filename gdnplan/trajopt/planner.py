@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -18,9 +19,10 @@ from ..models import CoalModel, DistanceModel, load_model
 from ..scene import Scene
 from ..timing import limit_vector, plan_timing
 from .adam import _plan_adam
+from .config import AdamConfig, IpoptConfig, PlanConfig, finite_budget, with_optimizer
 from .ik import first_joint_barrier, tip_point, tip_position
 from .ipopt import _plan_ipopt
-from .options import ADAM_INTERPOLATED, IPOPT_INTERPOLATED, TrajoptOptions
+from .options import TrajoptOptions
 from .problem import Problem
 from .result import Plan, _finish
 
@@ -61,10 +63,13 @@ def checked(model: DistanceModel, scene: Scene) -> DistanceModel:
     return model
 
 
+Solver = PlanConfig | IpoptConfig | AdamConfig
+
+
 def plan(
     problem: Problem,
     collision: str | DistanceModel = "coal",
-    solver: str = "ipopt",
+    solver: Solver | str | None = None,
     weights: str | Path | None = None,
     seed: int = 0,
     options: TrajoptOptions | None = None,
@@ -73,19 +78,20 @@ def plan(
 ) -> Plan:
     """Plan a trajectory for ``problem``; see :mod:`gdnplan.trajopt` for the formulation.
 
-    ``options`` default to the problem's own solver settings (``problem.solver``), else to
-    :class:`TrajoptOptions`' defaults. ``max_velocity`` (rad/s; default: the URDF's limits)
-    and ``max_acceleration`` (rad/s²; default None: velocity limits only), one number or one
-    per joint, time the certified path (:func:`gdnplan.timing.time_path`, ``Plan.times``).
+    ``solver``: the planner settings (:func:`plan_config`): a :class:`PlanConfig`, or an
+    :class:`IpoptConfig` / :class:`AdamConfig` alone (that optimiser, with the problem's seed
+    and refine settings); None: the problem's own (``problem.solver``), else the defaults
+    (Ipopt). The strings "ipopt"/"adam" and ``options`` (a TrajoptOptions) are deprecated.
+    ``seed``: the random stream of the first seed path (seed i uses ``seed + i``).
+    ``max_velocity`` (rad/s; default: the URDF's limits) and ``max_acceleration`` (rad/s²;
+    default None: velocity limits only), one number or one per joint, time the certified path
+    (:func:`gdnplan.timing.time_path`, ``Plan.times``).
 
     Raises GdnplanError on bad input; a failed solve returns ``Plan(success=False, reason=…)``.
     """
     t0 = time.perf_counter()
-    opts = options or problem.solver or TrajoptOptions()
-    if not isinstance(opts, TrajoptOptions):
-        raise InputError(f"options: expected TrajoptOptions, got {type(opts).__name__}")
-    opts = replace(opts)  # re-runs the checks (a frozen dataclass can still be forged)
-    _check_sizes(problem, opts, solver)
+    cfg = plan_config(problem, solver, options)
+    _check_sizes(problem, cfg)
     dof = problem.scene.robot.dof
     if max_velocity is not None:
         max_velocity = limit_vector(max_velocity, dof, "max_velocity", "rad/s")
@@ -93,12 +99,11 @@ def plan(
         max_acceleration = limit_vector(max_acceleration, dof, "max_acceleration", "rad/s²")
     model = resolve_model(collision, problem.scene, weights)
     goal = problem.goal if problem.goal is not None else numeric_ik(problem, seed)
-    if solver == "ipopt":
-        run = _plan_ipopt(problem, model, goal, opts, seed)
-    elif solver == "adam":
-        run = _plan_adam(problem, model, goal, opts)
+    deadline = t0 + finite_budget(cfg.seed.time_budget)
+    if isinstance(cfg.optimizer, IpoptConfig):
+        run = _plan_ipopt(problem, model, goal, cfg, seed, deadline)
     else:
-        raise InputError(f"solver: unknown {solver!r}; choose 'ipopt' or 'adam'")
+        run = _plan_adam(problem, model, goal, cfg, seed, deadline)
     result = _finish(problem, run, t0)
     trajectory, note = plan_timing(
         problem.scene, result.q, result.success, max_velocity, max_acceleration
@@ -107,14 +112,52 @@ def plan(
     return replace(result, trajectory=trajectory, reason=reason)
 
 
-def _check_sizes(problem: Problem, opts: TrajoptOptions, solver: str) -> None:
+def plan_config(
+    problem: Problem, solver: Solver | str | None = None, options: TrajoptOptions | None = None
+) -> PlanConfig:
+    """The checked PlanConfig :func:`plan` runs: ``solver`` when it is a PlanConfig; else the
+    problem's settings (``problem.solver``, else the defaults) with the optimiser ``solver``
+    names (an IpoptConfig or AdamConfig; None keeps the problem's)."""
+    base = problem.solver or PlanConfig()
+    if options is not None:
+        if not isinstance(options, TrajoptOptions):
+            raise InputError(f"options: expected TrajoptOptions, got {type(options).__name__}")
+        warnings.warn(
+            "plan(options=TrajoptOptions(...)) is deprecated; pass solver=gdnplan.PlanConfig(...)",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        kind = solver if isinstance(solver, str) else "adam" * isinstance(solver, AdamConfig)
+        base = options.to_config(kind or "ipopt")
+    if isinstance(solver, str):
+        base = with_optimizer(base, solver)
+        new = f"gdnplan.{type(base.optimizer).__name__}()"
+        warnings.warn(
+            f"plan(solver={solver!r}) is deprecated; pass solver={new}",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        solver = base.optimizer
+    if isinstance(solver, PlanConfig):
+        cfg = solver
+    elif isinstance(solver, (IpoptConfig, AdamConfig)):
+        cfg = replace(base, optimizer=solver)
+    elif solver is None:
+        cfg = base
+    else:
+        raise InputError(
+            f"solver: expected a PlanConfig, IpoptConfig or AdamConfig, got {type(solver).__name__}"
+        )
+    return cfg.checked()  # re-runs the checks (a frozen dataclass can still be forged)
+
+
+def _check_sizes(problem: Problem, cfg: PlanConfig) -> None:
     """InputError when the first solve would exceed ``MAX_CHECK_POINTS`` check points."""
-    default = IPOPT_INTERPOLATED if solver == "ipopt" else ADAM_INTERPOLATED
-    per_segment = (default if opts.interpolated is None else opts.interpolated) + opts.starts
+    per_segment = cfg.interpolated + cfg.seed.starts
     total = (problem.waypoints - 1) * per_segment
     if total > MAX_CHECK_POINTS:
         raise InputError(
-            f"options.waypoints × solver.interpolated: {total} check points, the limit is "
+            f"options.waypoints × interpolated: {total} check points, the limit is "
             f"{MAX_CHECK_POINTS}; use fewer waypoints or check points"
         )
 

@@ -15,19 +15,11 @@ from ..distance import signed_distance
 from ..errors import InfeasibleProblemError, InputError, ProblemFileError
 from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number
 from ..robot import first_outside
-from ..scene import Scene, scene_from_config
+from ..scene import Scene
+from .config import PlanConfig
 from .ik import first_joint_barrier, tip_reach
 from .options import TrajoptOptions
-from .problem_file import (
-    GOAL_KEYS,
-    OPTION_KEYS,
-    START_KEYS,
-    TOP_KEYS,
-    _no_unknown,
-    _solver_options,
-    _vector,
-    read_problem_file,
-)
+from .problem_file import ProblemTables, _vector, problem_tables, read_problem_file
 
 
 @dataclass(frozen=True, eq=False)
@@ -47,9 +39,11 @@ class Problem:
         goal_tolerance: end-effector position error accepted for ``goal_position`` (m).
         lower: (dof,) lower joint limits (rad), within the robot's; the robot's when None.
         upper: (dof,) upper joint limits (rad), within the robot's; the robot's when None.
-        solver: the solver settings this problem needs (a problem file's ``[solver]`` table,
-            e.g. short RRT-Connect steps for a narrow passage); :func:`plan` uses them unless
-            it is given ``options``. None: the defaults.
+        solver: the planner settings this problem needs (a problem file's ``[seed]``,
+            ``[refine]``, ``[ipopt]`` / ``[adam]`` tables, e.g. short RRT-Connect steps for a
+            narrow passage), a :class:`~gdnplan.trajopt.config.PlanConfig`; :func:`plan` uses
+            them unless given others. None: the defaults. (A TrajoptOptions is deprecated and
+            converted.)
         clearance: the clearance (m) a successful plan's coal certificate must prove along the
             whole continuous path, 0 ≤ clearance ≤ margin; None: the margin. Ask for less than
             the margin (e.g. 0: proven collision-free) to accept paths that dip below the
@@ -66,7 +60,7 @@ class Problem:
     goal_tolerance: float = 1e-3
     lower: np.ndarray = field(default=None)  # type: ignore[assignment]
     upper: np.ndarray = field(default=None)  # type: ignore[assignment]
-    solver: TrajoptOptions | None = None
+    solver: PlanConfig | None = None
     clearance: float | None = None
 
     @property
@@ -101,8 +95,10 @@ class Problem:
         check_number(self.max_step, "options.max_step", strict=True)
         check_number(self.goal_tolerance, "options.goal_tolerance", strict=True)
         self._check_limits()
-        if self.solver is not None and not isinstance(self.solver, TrajoptOptions):
-            raise InputError(f"solver: expected TrajoptOptions, got {type(self.solver).__name__}")
+        if isinstance(self.solver, TrajoptOptions):  # deprecated (it warned when made)
+            set_(self, "solver", self.solver.to_config())
+        if self.solver is not None and not isinstance(self.solver, PlanConfig):
+            raise InputError(f"solver: expected a PlanConfig, got {type(self.solver).__name__}")
         self._check_feasible()
 
     def _check_clearance(self) -> None:
@@ -185,36 +181,21 @@ class Problem:
     def from_config(cls, cfg: dict, base_dir: str | Path | None = None) -> Problem:
         """Problem from a parsed TOML mapping (see :meth:`from_toml`); relative paths in it
         (``[robot] urdf``) start at ``base_dir``, the current directory when None."""
-        _no_unknown(cfg, TOP_KEYS, "top level")
-        for key in ("start", "goal"):
-            if not isinstance(cfg.get(key), dict):
-                raise ProblemFileError(f"[{key}]: missing table", schema=True)
-        _no_unknown(cfg["start"], START_KEYS, "[start]")
-        _no_unknown(cfg["goal"], GOAL_KEYS, "[goal]")
-        options = cfg.get("options", {})
-        if not isinstance(options, dict):
-            raise ProblemFileError("[options]: expected a table")
-        _no_unknown(options, OPTION_KEYS, "[options]")
-        solver = _solver_options(cfg.get("solver"))
-        try:
-            scene = scene_from_config(cfg, base_dir)
-        except TypeError as e:
-            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
-        goal = cfg["goal"]
-        if ("q" in goal) == ("position" in goal):
-            raise ProblemFileError(
-                "[goal]: give exactly one of q = [...] or position = [x, y]", schema=True
-            )
-        if "q" not in cfg["start"]:
-            raise ProblemFileError("[start] q: missing; give the start joint angles", schema=True)
+        return cls.from_tables(problem_tables(cfg, base_dir))
+
+    @classmethod
+    def from_tables(cls, tables: ProblemTables) -> Problem:
+        """Problem from a file's checked tables
+        (:func:`~gdnplan.trajopt.problem_file.problem_tables`)."""
+        goal = tables.goal or {}
         try:
             return cls(
-                scene=scene,
-                start=cfg["start"]["q"],
+                scene=tables.scene,
+                start=tables.start,
                 goal=goal.get("q"),
                 goal_position=goal.get("position"),
-                solver=solver,
-                **options,
+                solver=tables.solver,
+                **tables.options,
             )
         except InputError as e:
             raise ProblemFileError(str(e)) from e

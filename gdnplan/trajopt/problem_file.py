@@ -1,14 +1,17 @@
-"""Problem files: reading the TOML, the keys of each table, the ``[solver]`` table as
-:class:`~gdnplan.trajopt.TrajoptOptions`, and the checked vectors they hold.
+"""Problem files: reading the TOML, the keys of each table, the planner tables (``[seed]``,
+``[refine]``, ``[ipopt]``, ``[adam]``, and the deprecated ``[solver]``) as a
+:class:`~gdnplan.trajopt.config.PlanConfig`, and the checked vectors they hold.
 
-``docs/problem_file.md`` documents every key; ``tests/test_problem_file_docs.py`` checks it
-against the key sets here.
+:func:`problem_tables` is the one parser of a problem file's tables: :meth:`Problem.from_config`
+and the CLI's ``show`` both use it. ``docs/problem_file.md`` documents every key;
+``tests/test_problem_file_docs.py`` checks it against the key sets here.
 """
 
 from __future__ import annotations
 
 import tomllib
-from dataclasses import replace
+import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -16,17 +19,25 @@ import numpy as np
 from ..assets import problem_file
 from ..errors import InputError, ProblemFileError
 from ..limits import IPOPT_OPTIONS, is_number
-from ..scene import Scene, no_unknown_keys
-from .options import SOLVER_KEYS, TrajoptOptions
+from ..scene import Scene, no_unknown_keys, scene_from_config
+from .config import CONFIG_TABLES, AdamConfig, IpoptConfig, PlanConfig, config_keys
+from .options import OLD_KEYS, REMOVED, SOLVER_KEYS
 
 # problem-file keys (docs/problem_file.md documents each; tests/test_problem_file_docs.py checks);
-# [robot], [scene], [[obstacles]]: scene.ROBOT_KEYS etc.; [solver]: SOLVER_KEYS
-TOP_KEYS = frozenset({"robot", "scene", "obstacles", "start", "goal", "options", "solver"})
+# [robot], [scene], [[obstacles]]: scene.ROBOT_KEYS etc.; [seed] … [adam]: CONFIG_KEYS;
+# [solver] (deprecated): SOLVER_KEYS
+PLAN_TABLES = tuple(CONFIG_TABLES)  # seed, refine, ipopt, adam
+TOP_KEYS = frozenset(
+    {"robot", "scene", "obstacles", "start", "goal", "options", "solver", *PLAN_TABLES}
+)
 START_KEYS = frozenset({"q"})
 GOAL_KEYS = frozenset({"q", "position"})  # exactly one of them
 OPTION_KEYS = frozenset(
     {"waypoints", "margin", "clearance", "max_step", "goal_tolerance", "lower", "upper"}
 )
+CONFIG_KEYS = {table: config_keys(kind) for table, kind in CONFIG_TABLES.items()}
+HOME = {key: table for table, keys in CONFIG_KEYS.items() for key in keys}  # key -> its table
+HOME["interpolated"] = "ipopt] or [adam"  # in both
 
 
 def read_problem_file(path: str | Path) -> dict:
@@ -48,10 +59,55 @@ def read_problem_file(path: str | Path) -> dict:
         raise ProblemFileError(f"{path}: arrays or tables nest too deeply; flatten them") from e
 
 
+@dataclass(frozen=True)
+class ProblemTables:
+    """A problem file's tables, checked but not yet a Problem: the scene, the raw ``[start] q``
+    and ``[goal]`` (None when absent), the ``[options]`` and the planner settings."""
+
+    scene: Scene
+    start: object
+    goal: dict | None
+    options: dict
+    solver: PlanConfig | None
+
+
+def problem_tables(cfg: dict, base_dir=None, require_goal: bool = True) -> ProblemTables:
+    """Check every table of a parsed problem file and build its scene and planner settings;
+    ``require_goal``: a ``[start] q`` and a ``[goal]`` must be there (False: a scene-only file,
+    as ``gdnplan show`` draws). ProblemFileError names any bad field."""
+    _no_unknown(cfg, TOP_KEYS, "top level")
+    for key, keys in (("start", START_KEYS), ("goal", GOAL_KEYS)):
+        if key not in cfg and not require_goal:
+            continue
+        if key not in cfg:
+            raise ProblemFileError(f"[{key}]: missing table", schema=True)
+        if not isinstance(cfg[key], dict):
+            raise ProblemFileError(f"[{key}]: expected a table, got {cfg[key]!r}")
+        _no_unknown(cfg[key], keys, f"[{key}]")
+    options = cfg.get("options", {})
+    if not isinstance(options, dict):
+        raise ProblemFileError("[options]: expected a table")
+    _no_unknown(options, OPTION_KEYS, "[options]")
+    solver = plan_config_from_tables(cfg)
+    try:
+        scene = scene_from_config(cfg, base_dir)
+    except TypeError as e:
+        raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
+    goal = cfg.get("goal")
+    if goal is not None and ("q" in goal) == ("position" in goal):
+        raise ProblemFileError(
+            "[goal]: give exactly one of q = [...] or position = [x, y]", schema=True
+        )
+    start = cfg.get("start")
+    if start is not None and "q" not in start:
+        raise ProblemFileError("[start] q: missing; give the start joint angles", schema=True)
+    return ProblemTables(scene, None if start is None else start.get("q"), goal, options, solver)
+
+
 def problem_start(cfg: dict, scene: Scene) -> np.ndarray | None:
     """The checked ``[start] q`` of a parsed problem file (None when absent), for drawing;
-    the ``[solver]`` table is checked too (what ``plan`` rejects, ``show`` rejects)."""
-    _solver_options(cfg.get("solver"))
+    the planner tables are checked too (what ``plan`` rejects, ``show`` rejects)."""
+    plan_config_from_tables(cfg)
     start = cfg.get("start")
     if start is None:
         return None
@@ -65,29 +121,93 @@ def problem_start(cfg: dict, scene: Scene) -> np.ndarray | None:
         raise ProblemFileError(str(e)) from e
 
 
-def _solver_options(table: dict | None) -> TrajoptOptions | None:
-    """TrajoptOptions from a problem file's ``[solver]`` table (None when absent)."""
-    if table is None:
+def plan_config_from_tables(cfg: dict) -> PlanConfig | None:
+    """The PlanConfig of a file's ``[seed]``, ``[refine]``, ``[ipopt]`` and ``[adam]`` tables
+    (None when it has none); an ``[adam]`` table picks the Adam optimiser (at most one of
+    ``[ipopt]`` and ``[adam]``). A deprecated ``[solver]`` table is mapped key by key onto
+    them (:data:`~gdnplan.trajopt.options.OLD_KEYS`) with a DeprecationWarning."""
+    tables = {t: _table(cfg[t], t) for t in PLAN_TABLES if t in cfg}
+    if "solver" in cfg:
+        _merge_old_solver(_table(cfg["solver"], "solver"), tables)
+    if not tables:
         return None
-    if not isinstance(table, dict):
-        raise ProblemFileError("[solver]: expected a table")
-    _no_unknown(table, SOLVER_KEYS, "[solver]")
-    if isinstance(table.get("ipopt"), dict):
-        _no_unknown(table["ipopt"], IPOPT_OPTIONS.keys(), "[solver.ipopt]")
-    defaults = TrajoptOptions()
-    for key, value in table.items():
-        default = getattr(defaults, key)  # None: int or bool settings with an automatic choice
-        kind = (int, float) if type(default) is float else type(default)
-        if default is not None and (
-            not isinstance(value, kind) or isinstance(value, bool) != isinstance(default, bool)
-        ):
-            names = {float: "a number", int: "an integer", bool: "true or false", dict: "a table"}
-            wanted = names.get(type(default), f"a {type(default).__name__}")
-            raise ProblemFileError(f"[solver] {key}: expected {wanted}, got {value!r}")
-    try:
-        return replace(defaults, **table)
-    except InputError as e:
-        raise ProblemFileError(f"[solver] {e}") from e
+    if "ipopt" in tables and "adam" in tables:
+        raise ProblemFileError(
+            "[ipopt], [adam]: give at most one; the table picks the optimiser the problem is "
+            "set up for (gdnplan plan --solver picks another)"
+        )
+    for table, values in tables.items():
+        for key, value in values.items():
+            _typed(value, getattr(CONFIG_TABLES[table](), key), f"[{table}] {key}")
+    optimizer = AdamConfig if "adam" in tables else IpoptConfig
+    built = {}
+    for table, name in (("seed", "seed"), ("refine", "refine"), ("ipopt", None), ("adam", None)):
+        if table in tables or (name is None and CONFIG_TABLES[table] is optimizer):
+            try:
+                built[name or "optimizer"] = CONFIG_TABLES[table](**tables.get(table, {}))
+            except InputError as e:
+                raise ProblemFileError(f"[{table}] {e}") from e
+    return PlanConfig(**built)
+
+
+def _table(value, name: str) -> dict:
+    """A planner table's keys, each checked to belong here (naming the table it belongs in)."""
+    if not isinstance(value, dict):
+        raise ProblemFileError(f"[{name}]: expected a table")
+    allowed = SOLVER_KEYS if name == "solver" else CONFIG_KEYS[name]
+    for key in value:
+        if key not in allowed and key in HOME:
+            raise ProblemFileError(
+                f"[{name}] {key}: not a [{name}] key; it belongs in [{HOME[key]}]"
+            )
+    _no_unknown(value, allowed, f"[{name}]")
+    options = value.get("options" if name == "ipopt" else "ipopt")
+    if name in ("ipopt", "solver") and isinstance(options, dict):
+        where = "[ipopt.options]" if name == "ipopt" else "[solver.ipopt]"
+        _no_unknown(options, IPOPT_OPTIONS.keys(), where)
+    return dict(value)
+
+
+def _merge_old_solver(old: dict, tables: dict[str, dict]) -> None:
+    """Map a deprecated ``[solver]`` table's keys onto the new tables (warns once)."""
+    homes = []
+    to_adam = any(k.startswith("adam_") for k in old) and not any(
+        OLD_KEYS[k] is not None and OLD_KEYS[k][0] == "ipopt" and k != "interpolated" for k in old
+    )
+    for key, value in old.items():
+        home = OLD_KEYS[key]
+        if home is None:
+            raise ProblemFileError(f"[solver] {key}: {REMOVED}; delete the line")
+        table, new = ("adam", "interpolated") if key == "interpolated" and to_adam else home
+        default = getattr(CONFIG_TABLES[table](), new)
+        _typed(value, default, f"[solver] {key}")
+        try:
+            CONFIG_TABLES[table](**{new: value})
+        except InputError as e:
+            raise ProblemFileError(f"[solver] {key} (now [{table}] {new}): {e}") from e
+        if new in tables.get(table, {}):
+            raise ProblemFileError(f"[solver] {key}: also set as [{table}] {new}; keep that one")
+        tables.setdefault(table, {})[new] = value
+        homes.append(f"{key} → [{table}] {new}")
+    warnings.warn(
+        f"problem file: the [solver] table is deprecated; move its keys: {', '.join(homes)}",
+        DeprecationWarning,
+        stacklevel=4,
+    )
+
+
+def _typed(value, default, where: str) -> None:
+    """ProblemFileError unless ``value`` has the TOML type of ``default`` (None: any; the
+    config's own check judges it)."""
+    if default is None:
+        return
+    kind = (int, float) if type(default) is float else type(default)
+    kind = list if kind is tuple else kind
+    if not isinstance(value, kind) or isinstance(value, bool) != isinstance(default, bool):
+        names = {float: "a number", int: "an integer", bool: "true or false", dict: "a table"}
+        names[tuple] = "a list"
+        wanted = names.get(type(default), f"a {type(default).__name__}")
+        raise ProblemFileError(f"{where}: expected {wanted}, got {value!r}")
 
 
 _no_unknown = no_unknown_keys  # the check of every table's keys (cli.py uses it too)
@@ -111,11 +231,15 @@ def _vector(value, n: int, name: str) -> np.ndarray:
 
 
 __all__ = [
+    "CONFIG_KEYS",
     "GOAL_KEYS",
     "OPTION_KEYS",
     "SOLVER_KEYS",
     "START_KEYS",
     "TOP_KEYS",
+    "ProblemTables",
+    "plan_config_from_tables",
     "problem_start",
+    "problem_tables",
     "read_problem_file",
 ]

@@ -14,6 +14,7 @@ from ..errors import InputError
 from ..timing import TimedTrajectory
 from .ik import tip_position
 from .problem import Problem
+from .seeds import SeedInfo
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
@@ -40,7 +41,11 @@ class Plan:
         reason: why the plan failed (or which attempt succeeded).
         path_cost: Σ_t ‖q_{t+1} − q_t‖² (rad²).
         model_calls: batched distance-model calls made by the solver.
-        attempts: solver runs made.
+        attempts: seeds tried (each refined unless its seed kind found no path); 0 when the
+            straight line was certified free.
+        seed: the seed the returned path was refined from (kind, index among the seeds
+            tried, random stream); the straight line's when it was certified free, or for
+            Adam; None when no seed's refined path was certified.
         clearance: the clearance the certificate was asked to prove (m,
             ``Problem.certified_clearance``); on success min_distance > clearance.
         trajectory: the time parametrisation of the certified path
@@ -62,6 +67,7 @@ class Plan:
     sampled_min_distance: float
     clearance: float = 0.0
     trajectory: TimedTrajectory | None = None
+    seed: SeedInfo | None = None
 
     @property
     def times(self) -> np.ndarray | None:
@@ -100,6 +106,7 @@ class _Run:
     model_calls: int = 0
     attempts: int = 0
     verified: Certificate | None = None  # q's certificate at the certified clearance, if made
+    seed: SeedInfo | None = None  # the seed q was refined from, when certified
 
 
 def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
@@ -130,6 +137,7 @@ def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
         attempts=run.attempts,
         sampled_min_distance=cert.min_distance,
         clearance=clearance,
+        seed=run.seed,
     )
 
 

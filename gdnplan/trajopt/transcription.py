@@ -10,6 +10,7 @@ import numpy as np
 from ..casadi_bridge import DistanceCallback
 from ..models import DistanceModel
 from .check_points import _interpolation_matrix, _path_parameters
+from .config import IpoptConfig
 from .problem import Problem
 
 WARM_START_OPTIONS = {  # Ipopt options of refine rounds started from the last primal-dual point
@@ -30,7 +31,7 @@ class _Transcription:
         problem: Problem,
         model: DistanceModel,
         goal,
-        opts,
+        opts: IpoptConfig,
         splits: np.ndarray,
         margin: float | np.ndarray,
         warm: bool = False,
@@ -77,7 +78,7 @@ class _Transcription:
             "mu_strategy": "adaptive",
             "sb": "yes",  # no banner: stdout stays clean for --json
         }
-        ipopt.update(opts.ipopt)
+        ipopt.update(opts.options)
         if warm:  # a refine round: start from the last round's primal-dual point
             ipopt.update(WARM_START_OPTIONS)
         self.solver = casadi.nlpsol(

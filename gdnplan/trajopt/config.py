@@ -1,0 +1,298 @@
+"""Planner settings, one small frozen dataclass per concern, each checked when made.
+
+=================== ====================== ==================================================
+config              problem-file table     concern
+=================== ====================== ==================================================
+:class:`SeedConfig`   ``[seed]``           initial guesses: the straight line, RRT-Connect
+                                           seeds, how many seeds, the wall-time budget
+:class:`RefineConfig` ``[refine]``         the continuous certificate and the refine rounds
+:class:`IpoptConfig`  ``[ipopt]``          Ipopt's NLP: check points, distance rows, stops
+:class:`AdamConfig`   ``[adam]``           the paper's Adam baseline
+:class:`PlanConfig`   (all four)           one of each; the optimiser is the type of
+                                           ``PlanConfig.optimizer`` (IpoptConfig or AdamConfig)
+=================== ====================== ==================================================
+
+A wrong type, NaN/inf or a value past its limit (:mod:`gdnplan.limits`) is an InputError naming
+the setting. :func:`gdnplan.plan` takes any of ``PlanConfig``, ``IpoptConfig`` or
+``AdamConfig`` as ``solver``; an optimiser config alone keeps the problem's seed and refine
+settings and picks that optimiser.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields, replace
+
+from ..errors import InputError
+from ..limits import (
+    MAX_ADAM_ITERATIONS,
+    MAX_INTERPOLATED,
+    MAX_ITER,
+    MAX_REFINE_ROUNDS,
+    MAX_RRT_TIME,
+    MAX_SEEDS,
+    MAX_STARTS,
+    MAX_TIME_BUDGET,
+    MAX_WAYPOINTS,
+    check_int,
+    check_ipopt,
+    check_number,
+)
+
+INITIAL_GUESSES = ("auto", "straight", "rrt")
+# seed kind name -> function SeedRequest -> (T, dof) path or None; filled by
+# gdnplan.trajopt.seeds (the shipped kinds) and seeds.register_seed_kind
+SEED_KINDS: dict[str, Callable] = {}
+
+
+def _check_bools(cfg, names: tuple[str, ...]) -> None:
+    for name in names:
+        if not isinstance(getattr(cfg, name), bool):
+            raise InputError(f"{name}: expected true or false, got {getattr(cfg, name)!r}")
+
+
+@dataclass(frozen=True)
+class SeedConfig:
+    """Initial guesses of the Ipopt optimiser (Adam always starts from the straight line).
+
+    Attributes:
+        initial: "auto" (the straight line when it is certified free, else seed paths),
+            "straight" (the straight line, perturbed by N(0, 0.2 rad) for later seeds) or
+            "rrt" (always seed paths).
+        count: seed paths refined; the certified path of least path cost Σ‖Δq‖² among them
+            is returned. None: 1 without ``time_budget``; with one, seeds until it ends
+            (at most ``limits.MAX_SEEDS``).
+        kinds: the seed kinds drawn in turn (seed i is of kind ``kinds[i % len(kinds)]``):
+            names of :data:`gdnplan.trajopt.seeds.SEED_KINDS` ("rrt": RRT-Connect;
+            "via": RRT-Connect through a random free via point, often another homotopy class).
+        starts: attempts of the first seed: an attempt whose path ends uncertified is
+            replaced by a new seed, at most ``starts − 1`` times over the whole call.
+        time_budget: wall time (s) of the whole call; when it ends, the best certified path
+            found so far is returned (an RRT-Connect run and an Ipopt solve are cut at it).
+            None: no budget.
+        rrt_time: time limit of one RRT-Connect run (s).
+        rrt_step: RRT-Connect extension (rad, joint-space 2-norm); narrow passages (the fetch
+            bring-out) may need ~0.3.
+        rrt_clearance: extra clearance (m) above the margin demanded of seed paths (at most
+            half the start's and goal's own clearance above the margin); when RRT-Connect finds
+            no such path, the same seed retries demanding the margin only.
+    """
+
+    initial: str = "auto"
+    count: int | None = None
+    kinds: tuple[str, ...] = ("rrt",)
+    starts: int = 3
+    time_budget: float | None = None
+    rrt_time: float = 5.0
+    rrt_step: float = 2.0
+    rrt_clearance: float = 0.02
+
+    def __post_init__(self) -> None:
+        if self.initial not in INITIAL_GUESSES:
+            raise InputError(f"initial: unknown {self.initial!r}; choose one of {INITIAL_GUESSES}")
+        if self.count is not None:
+            check_int(self.count, "count", 1, MAX_SEEDS)
+        if isinstance(self.kinds, list):
+            object.__setattr__(self, "kinds", tuple(self.kinds))
+        if not isinstance(self.kinds, tuple) or not self.kinds:
+            raise InputError(f"kinds: expected a list of seed kind names, got {self.kinds!r}")
+        for kind in self.kinds:
+            if not isinstance(kind, str) or kind not in SEED_KINDS:
+                raise InputError(
+                    f"kinds: unknown seed kind {kind!r}; choose from {list(SEED_KINDS)}"
+                )
+        check_int(self.starts, "starts", 1, MAX_STARTS)
+        if self.time_budget is not None:
+            budget = check_number(self.time_budget, "time_budget", strict=True)
+            if budget > MAX_TIME_BUDGET:
+                raise InputError(f"time_budget: {budget} s is over the limit {MAX_TIME_BUDGET} s")
+        for name in ("rrt_step",):
+            check_number(getattr(self, name), name, strict=True)
+        check_number(self.rrt_clearance, "rrt_clearance")
+        if check_number(self.rrt_time, "rrt_time", strict=True) > MAX_RRT_TIME:
+            raise InputError(f"rrt_time: {self.rrt_time} s is over the limit {MAX_RRT_TIME} s")
+
+    @property
+    def seed_count(self) -> int:
+        """The number of seeds to refine: ``count``, or its automatic value."""
+        if self.count is not None:
+            return self.count
+        return 1 if self.time_budget is None else MAX_SEEDS
+
+
+@dataclass(frozen=True)
+class RefineConfig:
+    """The continuous certificate and the refine rounds after each solve.
+
+    Attributes:
+        ccd: refine the check points of segments the continuous certificate rejects and
+            re-solve.
+        rounds: re-solves with refined check points (with ``ccd``).
+        warm_start: (Ipopt) start each refine round from the last round's solution and
+            multipliers (new check points start with zero multipliers).
+        clearance_buffer: (Ipopt) the check points demand d ≥ max(margin, c + clearance_buffer)
+            (m), c the problem's certified clearance: Ipopt leaves active check points a hair
+            inside their bound, which a certificate at exactly that bound rejects, and the
+            buffer leaves the path room to bend between check points.
+        raise_window: (Ipopt, learned models) a refine round raises the model's margin on the
+            rejected segments and this many segments either side of each; None: on the
+            whole path.
+    """
+
+    ccd: bool = True
+    rounds: int = 3
+    warm_start: bool = True
+    clearance_buffer: float = 0.002
+    raise_window: int | None = 2
+
+    def __post_init__(self) -> None:
+        _check_bools(self, ("ccd", "warm_start"))
+        check_int(self.rounds, "rounds", 0, MAX_REFINE_ROUNDS)
+        check_number(self.clearance_buffer, "clearance_buffer")
+        if self.raise_window is not None:
+            check_int(self.raise_window, "raise_window", 0, MAX_WAYPOINTS)
+
+
+@dataclass(frozen=True)
+class IpoptConfig:
+    """The Ipopt optimiser (direct transcription, :mod:`gdnplan.trajopt`).
+
+    Attributes:
+        interpolated: M check points strictly between consecutive waypoints (before
+            refining); each replaced attempt adds one (see ``SeedConfig.starts``).
+        per_link: one distance row per link polygon (capped at ``link_cap``) instead of one;
+            None: when the model provides per-link distances (coal does).
+        link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
+        max_iter: Ipopt iteration cap per solve.
+        tol: Ipopt tolerance.
+        obj_change_tol: Ipopt also stops ("acceptable") once the relative change of the path
+            cost stays below this for 3 iterations at a feasible point (constraint violation
+            ≤ 1e-5): the certificate, not the KKT residual, judges the result.
+        options: extra Ipopt options (name → value, :data:`gdnplan.limits.IPOPT_OPTIONS`)
+            over gdnplan's, e.g. ``{"limited_memory_initialization": "scalar1"}``.
+    """
+
+    interpolated: int = 2
+    per_link: bool | None = None
+    link_cap: float = 0.3
+    max_iter: int = 150
+    tol: float = 1e-3
+    obj_change_tol: float = 1e-3
+    options: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        check_int(self.interpolated, "interpolated", 0, MAX_INTERPOLATED)
+        if self.per_link is not None:
+            _check_bools(self, ("per_link",))
+        check_int(self.max_iter, "max_iter", 1, MAX_ITER)
+        for name in ("link_cap", "tol", "obj_change_tol"):
+            check_number(getattr(self, name), name, strict=True)
+        check_ipopt(self.options)
+
+
+@dataclass(frozen=True)
+class AdamConfig:
+    """The paper's baseline: Adam on the collision cost C(d) = c / ((d − margin)² + ε) plus
+    the path cost, from the straight line (:func:`gdnplan.trajopt.adam.collision_cost`).
+
+    Attributes:
+        interpolated: M check points strictly between consecutive waypoints (Adam's stop
+            test reads the check points alone, so it keeps the paper-baseline density).
+        iterations: iteration cap.
+        lr: step size (rad).
+        c: the collision cost's constant c.
+        eps: the collision cost's ε.
+        stop: stop once every check point is this far above the margin (m).
+    """
+
+    interpolated: int = 3
+    iterations: int = 500
+    lr: float = 0.05
+    c: float = 1e-3
+    eps: float = 1e-3
+    stop: float = 0.01
+
+    def __post_init__(self) -> None:
+        check_int(self.interpolated, "interpolated", 0, MAX_INTERPOLATED)
+        check_int(self.iterations, "iterations", 1, MAX_ADAM_ITERATIONS)
+        for name in ("lr", "c", "eps"):
+            check_number(getattr(self, name), name, strict=True)
+        check_number(self.stop, "stop")
+
+
+Optimizer = IpoptConfig | AdamConfig
+
+
+@dataclass(frozen=True)
+class PlanConfig:
+    """Every planner setting: one config per concern; ``optimizer``'s type picks the optimiser."""
+
+    seed: SeedConfig = field(default_factory=SeedConfig)
+    refine: RefineConfig = field(default_factory=RefineConfig)
+    optimizer: IpoptConfig | AdamConfig = field(default_factory=IpoptConfig)
+
+    def __post_init__(self) -> None:
+        for name, kind in (("seed", SeedConfig), ("refine", RefineConfig)):
+            if not isinstance(getattr(self, name), kind):
+                raise InputError(
+                    f"{name}: expected {kind.__name__}, got {type(getattr(self, name)).__name__}"
+                )
+        if not isinstance(self.optimizer, (IpoptConfig, AdamConfig)):
+            raise InputError(
+                f"optimizer: expected IpoptConfig or AdamConfig, got "
+                f"{type(self.optimizer).__name__}"
+            )
+
+    def checked(self) -> PlanConfig:
+        """A copy with every config's checks re-run (a frozen dataclass can still be forged)."""
+        return PlanConfig(replace(self.seed), replace(self.refine), replace(self.optimizer))
+
+    @property
+    def interpolated(self) -> int:
+        """The optimiser's check points per segment before refining."""
+        return self.optimizer.interpolated
+
+
+OPTIMIZERS: dict[str, type] = {"ipopt": IpoptConfig, "adam": AdamConfig}
+
+
+def with_optimizer(config: PlanConfig, name: str) -> PlanConfig:
+    """``config`` with the optimiser ``name`` ("ipopt" or "adam"): its own optimiser settings
+    when they are of that kind, else that optimiser's defaults."""
+    if name not in OPTIMIZERS:
+        raise InputError(f"solver: unknown {name!r}; choose 'ipopt' or 'adam'")
+    own = isinstance(config.optimizer, OPTIMIZERS[name])
+    return replace(config, optimizer=config.optimizer if own else OPTIMIZERS[name]())
+
+
+CONFIG_TABLES: dict[str, type] = {  # problem-file table -> its config
+    "seed": SeedConfig,
+    "refine": RefineConfig,
+    "ipopt": IpoptConfig,
+    "adam": AdamConfig,
+}
+
+
+def config_keys(kind: type) -> frozenset[str]:
+    """The field names of a config dataclass (a problem-file table's keys)."""
+    return frozenset(f.name for f in fields(kind))
+
+
+def finite_budget(budget: float | None) -> float:
+    """``time_budget`` as seconds, +inf for None."""
+    return math.inf if budget is None else float(budget)
+
+
+__all__ = [
+    "CONFIG_TABLES",
+    "INITIAL_GUESSES",
+    "AdamConfig",
+    "IpoptConfig",
+    "Optimizer",
+    "PlanConfig",
+    "RefineConfig",
+    "SeedConfig",
+    "config_keys",
+    "with_optimizer",
+]

@@ -1,0 +1,181 @@
+"""Several seeds, the cheapest certified path, the time budget (gdnplan.trajopt.seeds, ipopt)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+import gdnplan as gp
+from gdnplan.ccd import certify_path
+from gdnplan.cli import run
+from gdnplan.errors import InfeasibleProblemError
+from gdnplan.trajopt import (
+    PlanConfig,
+    Problem,
+    SeedConfig,
+    SeedRequest,
+    plan,
+    register_seed_kind,
+    straight_line,
+)
+from gdnplan.trajopt.config import SEED_KINDS
+
+
+def assert_certified(problem: Problem, result) -> None:
+    """Success means the coal certificate proves the whole path above the certified clearance."""
+    assert result.min_distance > problem.certified_clearance
+    assert certify_path(problem.scene, result.q, problem.certified_clearance).ok
+
+
+def random_problem(scene_seed: int, q_seed: int) -> Problem:
+    """A planar2 problem in environment (b) whose straight line collides (None-free: assume)."""
+    scene = gp.make_scene("b", seed=scene_seed)
+    q = scene.robot.sample(2, seed=q_seed)
+    try:
+        problem = Problem(scene, q[0], q[1], waypoints=12, margin=0.02)
+    except InfeasibleProblemError:
+        assume(False)
+    line = straight_line(problem.start, problem.goal, problem.waypoints)
+    assume(not certify_path(scene, line, problem.margin, stop_early=True).ok)
+    return problem
+
+
+@pytest.mark.slow  # ~30 s: five random problems, each planned with one and three seeds
+@settings(max_examples=5, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(scene_seed=st.integers(0, 10_000), q_seed=st.integers(0, 10_000), seed=st.integers(0, 50))
+def test_more_seeds_never_return_a_costlier_certified_plan(scene_seed, q_seed, seed):
+    problem = random_problem(scene_seed, q_seed)
+    one = plan(problem, collision="coal", seed=seed)
+    cfg = PlanConfig(seed=SeedConfig(count=3))
+    three = plan(problem, collision="coal", solver=cfg, seed=seed)
+    for result in (one, three):
+        if result.success:
+            assert_certified(problem, result)
+            assert 0 <= result.seed.index < max(result.attempts, 1)
+            assert result.seed.stream == seed + result.seed.index
+    if one.success:  # the first seed of three is the one seed: same stream, same solve
+        assert three.success
+        assert three.path_cost <= one.path_cost + 1e-12
+        assert three.attempts >= one.attempts
+
+
+def test_several_seeds_are_deterministic_and_report_the_winner():
+    problem = Problem.from_toml("planar2_square")
+    cfg = PlanConfig(seed=SeedConfig(count=4))
+    a = plan(problem, collision="coal", solver=cfg, seed=5)
+    b = plan(problem, collision="coal", solver=cfg, seed=5)
+    np.testing.assert_array_equal(a.q, b.q)
+    assert a.seed == b.seed and a.attempts == b.attempts == 4
+    assert a.seed.kind == "rrt" and "least path cost of 4 certified" in a.reason
+    assert_certified(problem, a)
+    single = plan(problem, collision="coal", seed=5)  # the first of the four seeds
+    assert a.path_cost <= single.path_cost + 1e-12
+
+
+@pytest.mark.parametrize("stream", [0, 1, 2])
+def test_a_via_seed_passes_its_via_point_on_certified_edges(stream):
+    from gdnplan.trajopt.seeds import via_seed
+
+    problem = Problem.from_toml("planar2_square")
+    request = SeedRequest(problem, problem.goal, problem.margin, stream, 0, 5.0, 2.0)
+    path = via_seed(request)
+    if path is None:  # the via point lay where RRT-Connect found no way: allowed
+        return
+    assert path.shape == (problem.waypoints, 2)
+    np.testing.assert_allclose(path[[0, -1]], [problem.start, problem.goal])
+    assert certify_path(problem.scene, path, problem.margin).ok
+
+
+def test_a_registered_seed_kind_is_drawn_in_turn(monkeypatch):
+    """A new seed source is one function (how another planner's paths would come in)."""
+    calls = []
+
+    def arc(request: SeedRequest):
+        calls.append(request.stream)
+        p = request.problem
+        guess = straight_line(p.start, request.goal, p.waypoints)
+        guess[1:-1, 1] += 1.5 * np.sin(np.linspace(0, np.pi, p.waypoints))[1:-1]  # elbow detour
+        return np.clip(guess, p.lower, p.upper)
+
+    monkeypatch.setitem(SEED_KINDS, "probe", None)  # removed again after the test
+    register_seed_kind("probe", arc)
+    problem = Problem.from_toml("planar2_square")
+    cfg = PlanConfig(seed=SeedConfig(count=2, kinds=("rrt", "probe")))
+    result = plan(problem, collision="coal", solver=cfg, seed=3)
+    assert calls == [4]  # seed 1 of the call: stream 3 + 1
+    assert result.success and result.attempts == 2
+    assert_certified(problem, result)
+    with pytest.raises(gp.InputError, match="kinds"):
+        SeedConfig(kinds=("no_such_kind",))
+    with pytest.raises(gp.InputError, match="identifier"):
+        register_seed_kind("not a name", arc)
+
+
+def test_a_seed_kind_of_the_wrong_shape_is_an_input_error(monkeypatch):
+    monkeypatch.setitem(SEED_KINDS, "short", lambda request: np.zeros((2, 2)))
+    problem = Problem.from_toml("planar2_square")
+    with pytest.raises(gp.InputError, match="shape"):
+        plan(problem, collision="coal", solver=PlanConfig(seed=SeedConfig(kinds=("short",))))
+
+
+@pytest.mark.slow
+def test_the_time_budget_is_kept_within_one_solve():
+    """Anytime mode: seeds until the budget ends, the cheapest certified path found by then.
+    Bound: the budget plus one single-seed plan's time (Ipopt is cut at the time left, so at
+    most one iteration, one certificate and one NLP build run past it) plus 1 s of scheduling
+    slack on a shared machine — a loose bound, not a timing measurement."""
+    problem = Problem.from_toml("planar7_d")
+    single = plan(problem, collision="coal")
+    budget = 2.0
+    cfg = PlanConfig(seed=SeedConfig(time_budget=budget))
+    result = plan(problem, collision="coal", solver=cfg)
+    assert result.solve_time <= budget + single.solve_time + 1.0
+    if result.success:
+        assert_certified(problem, result)
+        assert result.attempts >= 1
+    else:
+        assert "time budget" in result.reason
+
+
+def test_a_budget_too_short_for_any_seed_fails_instead_of_returning_an_uncertified_path():
+    problem = Problem.from_toml("planar7_d")
+    cfg = PlanConfig(seed=SeedConfig(time_budget=1e-6, initial="rrt"))
+    result = plan(problem, collision="coal", solver=cfg)
+    assert not result.success and "time budget" in result.reason
+    assert result.seed is None
+
+
+def cli(args: list[str], capsys) -> tuple[int, str, str]:
+    """Exit status, stdout and stderr of ``gdnplan ARGS`` (as the console script runs it)."""
+    with pytest.raises(SystemExit) as done:
+        run(args)
+    out = capsys.readouterr()
+    return done.value.code, out.out, out.err
+
+
+def test_plan_json_names_the_winning_seed_and_the_seeds_tried(capsys):
+    args = ["plan", "planar2_square", "--collision", "coal", "--seeds", "2", "--json", "-q"]
+    code, out, err = cli(args, capsys)
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["attempts"] == 2
+    assert summary["seed"]["kind"] == "rrt" and summary["seed"]["index"] in (0, 1)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--seeds", "0"], "--seeds/--time-budget: count"),
+        (["--time-budget", "-1"], "time_budget"),
+        (["--solver", "adam", "--seeds", "2"], "--seeds: Adam"),
+        (["--solver", "bfgs"], "--solver: unknown"),
+    ],
+)
+def test_plan_flags_that_do_not_apply_are_input_errors(args, message, capsys):
+    code, _, err = cli(["plan", "planar2_square", "--collision", "coal", "-q", *args], capsys)
+    assert code == 2 and err.count("\n") == 1
+    assert err.startswith("error: ") and message in err, err
