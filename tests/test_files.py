@@ -174,7 +174,7 @@ def test_check_output_dir(tmp_path):
 
 # ------------------------------------------------------- the CLI checks outputs before the work
 COMMANDS = {  # command line with {out}, the function doing the work, the suffix it wants
-    "show": (["show", "a", "--out", "{out}"], "gdnplan.cli.scene_and_start", ".png"),
+    "show": (["show", "a", "--out", "{out}"], "gdnplan.cli.plan.scene_and_start", ".png"),
     "field": (["field", "--out", "{out}"], "gdnplan.evaluate.fig5", ".png"),
     "plan": (
         ["plan", "problems/planar2_square.toml", "--animate", "{out}"],

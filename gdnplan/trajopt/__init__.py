@@ -72,7 +72,7 @@ from .result import Plan, path_cost
 from .seeds import SEED_KINDS, SeedInfo, SeedRequest, register_seed_kind
 from .transcription import WARM_START_OPTIONS
 
-# private helpers that cli.py and tests/test_trajopt.py import from here
+# private helpers that the CLI and tests/test_trajopt.py import from here
 from .check_points import _check_point_raise, _near_segments, _path_parameters  # isort: skip
 from .problem_file import _no_unknown, _vector  # isort: skip
 from .transcription import _Transcription  # isort: skip

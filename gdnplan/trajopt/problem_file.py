@@ -210,7 +210,7 @@ def _typed(value, default, where: str) -> None:
         raise ProblemFileError(f"{where}: expected {wanted}, got {value!r}")
 
 
-_no_unknown = no_unknown_keys  # the check of every table's keys (cli.py uses it too)
+_no_unknown = no_unknown_keys  # the check of every table's keys (the CLI uses it too)
 
 
 def _vector(value, n: int, name: str) -> np.ndarray:

@@ -1,0 +1,5 @@
+"""``python -m gdnplan.cli``: the ``gdnplan`` command."""
+
+from . import main
+
+main()

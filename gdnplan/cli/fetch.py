@@ -1,0 +1,75 @@
+"""``gdnplan fetch``: the scripted UR5e fetch sequence."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from ..files import check_output_path
+
+if TYPE_CHECKING:  # the commands import numpy and the library when they run: a fast --help
+    pass
+
+from .app import app
+from .common import QUIET_HELP, THREADS_HELP, WEIGHTS_HELP, set_threads, show_progress
+from .plan import clearance_text
+
+
+@app.command("fetch")
+def fetch_command(
+    seed: int = typer.Option(0, min=0, help="Fetch layout: 0 canonical, others random storages."),
+    collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
+    weights: str = typer.Option(None, help=WEIGHTS_HELP),
+    animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
+    json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
+    view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
+) -> None:
+    """The UR5e fetch: approach, reach in, grasp, lift, bring the stick out, retreat.
+
+    Exit status: 0 when every stage is certified collision-free, 1 otherwise, 2 on bad input.
+    """
+    from ..fetch import run_fetch
+
+    show_progress(not quiet)
+    if animate is not None:
+        check_output_path(animate, (".gif",), "--animate")
+    set_threads(threads)
+    if view3d:  # fail before planning, not after
+        from ..viz3d import require_meshcat
+
+        require_meshcat()
+    stages = run_fetch(seed, collision=collision, weights=weights)
+    ok = all(s.success for s in stages)
+    if json_output:
+        summary = {"seed": seed, "collision": collision, "success": ok}
+        summary["stages"] = [s.summary() for s in stages]
+        typer.echo(json.dumps(summary))
+    else:
+        for s in stages:
+            how = "planned" if s.planned else "scripted"
+            verdict = "certified" if s.success else f"FAILED ({s.detail})"
+            typer.echo(
+                f"{s.name:<10} {s.scene.robot.info['gripper']:<8} {how:<8} {verdict}; "
+                f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
+            )
+        total = sum(s.solve_time for s in stages)
+        verdict = "success" if ok else "FAILED"
+        typer.echo(f"fetch seed {seed} ({collision}): {verdict}, {total:.1f} s in all")
+    if animate is not None:
+        from ..viz import animate_paths
+
+        title = f"fetch seed {seed}: {collision}"
+        animate_paths([(s.scene, s.q) for s in stages], animate, title=title)
+        if not json_output:
+            typer.echo(f"wrote {animate}")
+    if view3d:
+        from ..viz3d import view_plan
+
+        view_plan([(s.scene, s.q) for s in stages])
+    if not ok:
+        raise typer.Exit(1)

@@ -1,0 +1,200 @@
+"""``gdnplan show`` and ``gdnplan plan``, and the JSON summary of a plan."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from ..errors import InputError
+from ..files import FIGURE_SUFFIXES, check_output_path
+
+if TYPE_CHECKING:  # the commands import numpy and the library when they run: a fast --help
+    pass
+
+from .app import app
+from .common import (
+    PROBLEM_HELP,
+    QUIET_HELP,
+    THREADS_HELP,
+    WEIGHTS_HELP,
+    check_limits,
+    parse_vector,
+    scene_and_start,
+    set_threads,
+    show_progress,
+)
+
+
+@app.command()
+def show(
+    target: str = typer.Argument(
+        ..., help="A problem TOML file, a shipped problem's name or a scene name (a-e, fetch)."
+    ),
+    q: str = typer.Option(None, help="Joint angles 'q1,q2,...' (default: the problem's start)."),
+    seed: int = typer.Option(0, min=0, help="Scene seed, for generated scenes."),
+    out: Path = typer.Option(Path("scene.png"), help="Output PNG."),
+) -> None:
+    """Draw the robot, the obstacles and the witness segment of the signed distance."""
+    from ..viz import save_figure, scene_figure
+
+    check_output_path(out, FIGURE_SUFFIXES, "--out")
+    scene, start = scene_and_start(target, seed)
+    if q is not None:
+        config = check_limits(
+            scene.robot, scene.robot.check_q(parse_vector(q, "--q"), "--q")[0], "--q"
+        )
+    else:
+        config = start
+    fig = scene_figure(scene, config)
+    save_figure(fig, out)
+    typer.echo(f"wrote {out}")
+
+
+@app.command("plan")
+def plan_command(
+    problem_file: str = typer.Argument(..., help=PROBLEM_HELP),
+    collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
+    solver: str = typer.Option(
+        None,
+        help="ipopt (direct transcription) or adam (paper); default: the problem file's "
+        "optimiser ([ipopt] or [adam] table), else ipopt.",
+    ),
+    weights: str = typer.Option(None, help=WEIGHTS_HELP),
+    seed: int = typer.Option(0, min=0, help="Seed of the sampling-based initial guesses."),
+    seeds: int = typer.Option(
+        None,
+        help="Seed paths refined (Ipopt), the cheapest certified path returned; default: the "
+        "file's [seed] count, else 1 (with --time-budget: as many as fit).",
+    ),
+    time_budget: float = typer.Option(
+        None,
+        help="Wall-time budget (s): return the cheapest certified path found when it ends.",
+    ),
+    json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
+    view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
+    max_acceleration: float = typer.Option(
+        None, help="Joint acceleration limit (rad/s²) of the timing; default: velocity only."
+    ),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
+) -> None:
+    """Plan a collision-free trajectory; success is certified by a dense coal check.
+
+    Exit status: 0 when the plan is certified, 1 when planning failed, 2 on bad input.
+    """
+    from ..trajopt import Problem, plan
+
+    show_progress(not quiet)
+    if animate is not None:
+        check_output_path(animate, (".gif",), "--animate")
+    set_threads(threads)
+    if view3d:  # fail before planning, not after
+        from ..viz3d import require_meshcat
+
+        require_meshcat()
+    problem = Problem.from_toml(problem_file)
+    config = plan_flags_config(problem, solver, seeds, time_budget)
+    result = plan(
+        problem,
+        collision=collision,
+        solver=config,
+        weights=weights,
+        seed=seed,
+        max_acceleration=max_acceleration,
+    )
+    if json_output:
+        typer.echo(json.dumps(plan_summary(result, problem.scene.robot.joint_names)))
+    else:
+        verdict = "certified collision-free" if result.success else f"FAILED ({result.reason})"
+        timed = "" if result.duration is None else f", duration {result.duration:.2f} s"
+        typer.echo(
+            f"{problem_file}: {verdict}; {clearance_text(result.min_distance)}, "
+            f"solve time {result.solve_time:.2f} s, {result.iterations} iterations, "
+            f"path cost {result.path_cost:.3f}{timed}"
+        )
+    if animate is not None:
+        from ..viz import animate_paths
+
+        animate_paths(
+            [(problem.scene, result.q)], animate, title=f"{Path(problem_file).name}: {collision}"
+        )
+        if not json_output:
+            typer.echo(f"wrote {animate}")
+    if view3d:
+        from ..viz3d import view_plan
+
+        view_plan([(problem.scene, result.q)])
+    if not result.success:
+        raise typer.Exit(1)
+
+
+def plan_flags_config(problem, solver: str | None, seeds: int | None, time_budget: float | None):
+    """The PlanConfig of ``gdnplan plan``: the problem file's settings, with the optimiser
+    ``--solver`` names (the file's settings for it when the file is set up for it, else its
+    defaults) and ``--seeds`` / ``--time-budget`` over the file's ``[seed]`` table."""
+    from dataclasses import replace
+
+    from ..trajopt import AdamConfig, PlanConfig
+    from ..trajopt.config import OPTIMIZERS, with_optimizer
+
+    config = problem.solver or PlanConfig()
+    if solver is not None:  # the named optimiser, with the file's settings when they are its
+        if solver not in OPTIMIZERS:
+            raise InputError(f"--solver: unknown {solver!r}; choose ipopt or adam")
+        config = with_optimizer(config, solver)
+    if seeds is not None and isinstance(config.optimizer, AdamConfig):
+        raise InputError("--seeds: Adam starts from the straight line; seeds need --solver ipopt")
+    try:
+        count = config.seed.count if seeds is None else seeds
+        budget = config.seed.time_budget if time_budget is None else time_budget
+        config = replace(config, seed=replace(config.seed, count=count, time_budget=budget))
+    except InputError as e:
+        raise InputError(f"--seeds/--time-budget: {e}") from e
+    return config
+
+
+def clearance_text(lower_bound: float) -> str:
+    """'certified clearance ≥ +0.0123 m', or 'clearance not proven' for a −inf bound."""
+    if not math.isfinite(lower_bound):
+        return "clearance not proven"
+    return f"certified clearance ≥ {lower_bound:+.4f} m"
+
+
+def json_number(x: float) -> float | None:
+    """x as a JSON number; None (null) when not finite (JSON has no infinities)."""
+    return float(x) if math.isfinite(x) else None
+
+
+def plan_summary(result, joint_names: list[str]) -> dict:
+    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none;
+    clearance: the clearance its certificate had to prove).
+
+    ``t`` (s) is the time of each row of ``q`` (rad, columns in ``joint_names`` order), and
+    ``timing`` its kind (:mod:`gdnplan.timing`); both null when the plan has no trajectory.
+    """
+    traj = result.trajectory
+    import numpy as np
+
+    return {
+        "success": bool(result.success),
+        "joint_names": list(joint_names),
+        "q": np.asarray(result.q).tolist(),
+        "t": None if traj is None else traj.times.tolist(),
+        "duration": None if traj is None else traj.duration,
+        "timing": None if traj is None else traj.kind,
+        "min_distance": json_number(result.min_distance),
+        "sampled_min_distance": json_number(result.sampled_min_distance),
+        "clearance": float(result.clearance),
+        "solve_time": float(result.solve_time),
+        "iterations": int(result.iterations),
+        "status": result.status,
+        "reason": result.reason,
+        "path_cost": float(result.path_cost),
+        "seed": None if result.seed is None else result.seed.summary(),
+        "attempts": int(result.attempts),
+    }
