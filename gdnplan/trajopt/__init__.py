@@ -40,6 +40,8 @@ word alone.
 # ruff: noqa: F401  (the package's names, re-exported from the modules that define them)
 from __future__ import annotations
 
+import warnings
+
 from ..ccd import verify_path
 from .adam import collision_cost
 from .check_points import distance_bounds, model_overestimate, straight_line
@@ -100,3 +102,19 @@ __all__ = [
     "tip_position",
     "verify_path",
 ]
+
+_DEPRECATED = {"solve_ik": "numeric_ik"}  # old name -> its new name in this package
+
+
+def __getattr__(name: str) -> object:
+    """Deprecated names: warn (DeprecationWarning naming the new one), then return it."""
+    if name in _DEPRECATED:
+        new = _DEPRECATED[name]
+        warnings.warn(
+            f"gdnplan.trajopt.{name} is deprecated; use gdnplan.trajopt.{new} (the numeric IK "
+            "of a goal position; the UR5e's exact IK of a tcp pose is gdnplan.ur5e.analytic_ik)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return globals()[new]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
