@@ -1,38 +1,36 @@
 """Time per configuration of the exact 3-D signed distance (and + gradient) of gdnplan.arm3d.
 
-Usage: python benchmarks/coal3d_distance.py [--threads 1] [--n 200] [--repeats 3] [--out PATH]
-
 The UR5e (collision cylinders and boxes) and the Panda (collision meshes as convex hulls)
 among 20 random boxes (``random_boxes(robot, 20, seed)``, one scene per robot), self-collision
 included; the overall minimum with and without the broad phase, and the pairs sent to coal's
-narrow phase (GJK/EPA) per configuration. Writes a markdown table (best of the repeats) to
-benchmarks/results/coal3d_distance.md and prints it.
+narrow phase (GJK/EPA) per configuration; best of the repeats.
+
+    python benchmarks/coal3d_distance.py --threads 1 [--n 200] [--repeats 3] [--seed 0]
+
+``--threads`` also sets the BLAS/OpenMP threads (before numpy is imported).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import sys
+
+import common
 
 
-def parse() -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--threads", type=int, default=1, help="BLAS/OpenMP threads")
-    parser.add_argument("--n", type=int, default=200, help="configurations per robot")
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", default="benchmarks/results/coal3d_distance.md")
-    return parser.parse_args()
+def make_parser() -> argparse.ArgumentParser:
+    p = common.parser("coal3d_distance", __doc__)
+    p.add_argument("--n", type=int, default=200, help="configurations per robot")
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--seed", type=int, default=0)
+    return p
 
 
-ARGS = parse() if __name__ == "__main__" else None
-if ARGS is not None:  # before numpy is imported
+if __name__ == "__main__":  # BLAS/OpenMP threads before numpy is imported
+    _threads = make_parser().parse_known_args()[0].threads
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ[var] = str(ARGS.threads)
+        os.environ[var] = str(max(_threads, 1))
 
-import datetime  # noqa: E402
-import platform  # noqa: E402
 import time  # noqa: E402
 
 import coal  # noqa: E402
@@ -40,21 +38,6 @@ import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 
 from gdnplan.arm3d import Checker3D, load_robot3d, random_boxes  # noqa: E402
-
-
-def header(command: str) -> str:
-    """Command, machine, date and library versions of a results file (a local stand-in for
-    the shared benchmarks header)."""
-    machine = platform.processor() or platform.machine()
-    return "\n".join(
-        [
-            f"- command: `{command}`",
-            f"- machine: {machine}, {os.cpu_count()} cores ({platform.system()} "
-            f"{platform.release()}), Python {platform.python_version()}",
-            f"- date: {datetime.datetime.now(datetime.UTC).strftime('%Y-%m-%d %H:%M UTC')}",
-            f"- coal {coal.__version__}, pinocchio {pin.__version__}, numpy {np.__version__}",
-        ]
-    )
 
 
 def best(fn, repeats: int) -> tuple[float, object]:
@@ -66,8 +49,8 @@ def best(fn, repeats: int) -> tuple[float, object]:
     return min(times), out
 
 
-def rows(args: argparse.Namespace) -> list[str]:
-    out = []
+def measure(args: argparse.Namespace, table: common.Table) -> None:
+    """One row per robot and broad-phase setting (times per configuration)."""
     for name in ("ur5e", "panda"):
         robot = load_robot3d(name)
         scene = random_boxes(robot, 20, seed=args.seed)
@@ -82,36 +65,41 @@ def rows(args: argparse.Namespace) -> list[str]:
                 lambda b=broad, c=checker, q=q: c.evaluate(q, broad_phase=b, gradient=True),
                 args.repeats,
             )
-            out.append(
-                f"| {name} | {len(robot.shapes)} | {checker.n_pairs} "
-                f"({len(robot.self_pairs)} self) | {'on' if broad else 'off'} "
-                f"| {np.mean(res.narrow):.1f} | {1e3 * t_d / args.n:.3f} "
-                f"| {1e3 * t_g / args.n:.3f} | {colliding:.0%} |"
+            table.add(
+                name,
+                len(robot.shapes),
+                f"{checker.n_pairs} ({len(robot.self_pairs)} self)",
+                "on" if broad else "off",
+                f"{np.mean(res.narrow):.1f}",
+                f"{1e3 * t_d / args.n:.3f}",
+                f"{1e3 * t_g / args.n:.3f}",
+                f"{colliding:.0%}",
             )
-    return out
 
 
-def main(args: argparse.Namespace) -> None:
-    command = "python " + " ".join(sys.argv)
-    table = [
-        "# coal 3-D signed distance per configuration",
-        "",
-        header(command),
-        f"- {args.n} random configurations per robot within its joint limits, 20 random boxes "
-        f"(seed {args.seed}), best of {args.repeats} repeats; times are per configuration",
-        "",
-        "| robot | shapes | pairs | broad phase | narrow-phase pairs / config "
-        "| distance (ms) | distance + gradient (ms) | configs in collision |",
-        "|---|---|---|---|---|---|---|---|",
-        *rows(args),
-        "",
-    ]
-    text = "\n".join(table)
-    os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
-    with open(args.out, "w", encoding="utf-8") as f:
-        f.write(text)
-    print(text)
+def main() -> None:
+    args = common.parse(make_parser())
+    report = common.Report(
+        args, "coal 3-D signed distance per configuration", common.first_paragraph(__doc__)
+    )
+    report.text(
+        f"coal {coal.__version__}, pinocchio {pin.__version__}; {args.n} random configurations "
+        f"per robot within its joint limits, 20 random boxes (seed {args.seed}), best of "
+        f"{args.repeats} repeats; times are per configuration."
+    )
+    table = report.table(
+        "robot",
+        "shapes",
+        "pairs",
+        "broad phase",
+        "narrow-phase pairs / config",
+        "distance (ms)",
+        "distance + gradient (ms)",
+        "configs in collision",
+    )
+    measure(args, table)
+    report.write()
 
 
 if __name__ == "__main__":
-    main(ARGS)
+    main()

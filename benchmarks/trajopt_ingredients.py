@@ -18,18 +18,29 @@ import common
 import numpy as np
 
 import gdnplan as gp
-from gdnplan.trajopt import Plan, Problem, TrajoptOptions, plan, tip_position
+from gdnplan.trajopt import (
+    IpoptConfig,
+    Plan,
+    PlanConfig,
+    Problem,
+    RefineConfig,
+    SeedConfig,
+    plan,
+    tip_position,
+)
 
+STRAIGHT, NO_CCD = SeedConfig(initial="straight"), RefineConfig(ccd=False)
+ONE_ROW = IpoptConfig(per_link=False)  # one overall distance row per check point
 VARIANTS = {
-    "straight-line guess (prototype baseline)": TrajoptOptions(
-        initial="straight", ccd=False, per_link=False
+    "straight-line guess (prototype baseline)": PlanConfig(STRAIGHT, NO_CCD, ONE_ROW),
+    "RRT-Connect seed (line kept when certified free)": PlanConfig(
+        refine=NO_CCD, optimizer=ONE_ROW
     ),
-    "RRT-Connect seed (line kept when certified free)": TrajoptOptions(ccd=False, per_link=False),
-    "+ CCD certificate (re-solve with subdivided uncertified segments)": TrajoptOptions(
-        per_link=False
+    "+ CCD certificate (re-solve with subdivided uncertified segments)": PlanConfig(
+        optimizer=ONE_ROW
     ),
-    "+ per-link rows (default)": TrajoptOptions(),
-    "per-link without CCD certificate": TrajoptOptions(ccd=False),
+    "+ per-link rows (default)": PlanConfig(),
+    "per-link without CCD certificate": PlanConfig(refine=NO_CCD),
 }
 SOLVED = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
 
@@ -72,10 +83,10 @@ class Row:
         return sum(p.status in SOLVED and not p.success for p in self.plans)
 
 
-def run(problems: list, opts: TrajoptOptions) -> tuple[Plan, ...]:
+def run(problems: list, cfg: PlanConfig) -> tuple[Plan, ...]:
     out = []
     for i, p in enumerate(problems):
-        result = plan(p, collision="coal", seed=i, options=opts)
+        result = plan(p, collision="coal", seed=i, solver=cfg)
         print(
             f"  problem {i:2d}: {result.success!s:5} {result.solve_time:6.2f} s  {result.reason}",
             file=sys.stderr,
@@ -116,9 +127,9 @@ def main() -> None:
     )
     problems = make_problems(args.n, args.seed)
     rows = []
-    for name, opts in VARIANTS.items():
+    for name, cfg in VARIANTS.items():
         print(name, file=sys.stderr, flush=True)
-        rows.append(Row(name, run(problems, opts)))
+        rows.append(Row(name, run(problems, cfg)))
     report.text(
         f"{args.n} planar7 problems on environment (d), T = 20, margin 0.02 m, success = "
         "certified coal check of the path (conservative advancement) + goal reached. Time = "

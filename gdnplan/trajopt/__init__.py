@@ -21,9 +21,9 @@ only make the NLP infeasible.
 Continuous collision (the CCD certificate): after each solve, :func:`gdnplan.ccd.certify_path`
 checks the continuous motion with coal by conservative advancement at the clearance c; every
 waypoint segment it cannot certify gets twice as many check points (n_t ← 2 n_t) — and, for
-a learned model, the bound there and on ``raise_window`` segments either side is raised by
-the model's overestimate — and Ipopt re-solves from the current path, for ``refine_rounds``
-rounds.
+a learned model, the bound there and on ``raise_window`` segments either side is raised to
+the margin plus the model's observed overestimate (the largest seen so far, not a sum over
+rounds) — and Ipopt re-solves from the current path, for ``RefineConfig.rounds`` rounds.
 (The certificate as NLP rows, d(p_k) + d(p_{k+1}) ≥ δ(p_k, p_{k+1}) + 2·margin, was tried and
 dropped: at 3 check points per segment δ reaches ~1 m on seed paths, the rows are infeasible
 and Ipopt runs to its iteration cap.) Ipopt uses a limited-memory Hessian and starts from the
@@ -39,6 +39,8 @@ word alone.
 
 # ruff: noqa: F401  (the package's names, re-exported from the modules that define them)
 from __future__ import annotations
+
+import warnings
 
 from ..ccd import verify_path
 from .adam import collision_cost
@@ -100,3 +102,19 @@ __all__ = [
     "tip_position",
     "verify_path",
 ]
+
+_DEPRECATED = {"solve_ik": "numeric_ik"}  # old name -> its new name in this package
+
+
+def __getattr__(name: str) -> object:
+    """Deprecated names: warn (DeprecationWarning naming the new one), then return it."""
+    if name in _DEPRECATED:
+        new = _DEPRECATED[name]
+        warnings.warn(
+            f"gdnplan.trajopt.{name} is deprecated; use gdnplan.trajopt.{new} (the numeric IK "
+            "of a goal position; the UR5e's exact IK of a tcp pose is gdnplan.ur5e.analytic_ik)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return globals()[new]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

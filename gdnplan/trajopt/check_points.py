@@ -106,8 +106,8 @@ def distance_bounds(
     which q_e itself satisfies; the coal certificate still judges the whole path. Used by the
     Adam optimiser, whose stop test (over every check point, q_e included) would otherwise
     never pass. Ipopt keeps the plain margin and has no rows at q_e (package docstring): with
-    these bounds it optimised the fetch reach-in to a path cost of 0.09 but took 47 s and
-    hugged the storage (coal clearance 0.4 mm).
+    these bounds it was slow and its path hugged the obstacles
+    (docs/decisions.md#endpoint-relaxed-bounds-adam-only).
     """
     bounds = np.full(int(np.sum(splits)) + 1, margin)
     if isinstance(model, CoalModel):

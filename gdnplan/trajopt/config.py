@@ -137,7 +137,7 @@ class RefineConfig:
             buffer leaves the path room to bend between check points.
         raise_window: (Ipopt, learned models) a refine round raises the model's margin on the
             rejected segments and this many segments either side of each; None: on the
-            whole path.
+            whole path (docs/decisions.md#raise-window).
     """
 
     ccd: bool = True
@@ -160,7 +160,9 @@ class IpoptConfig:
 
     Attributes:
         interpolated: M check points strictly between consecutive waypoints (before
-            refining); each replaced attempt adds one (see ``SeedConfig.starts``).
+            refining); each replaced attempt adds one (see ``SeedConfig.starts``); the
+            certificate and refine rounds catch what sparse check points miss
+            (docs/decisions.md#ipopt-check-points-per-segment).
         per_link: one distance row per link polygon (capped at ``link_cap``) instead of one;
             None: when the model provides per-link distances (coal does).
         link_cap: per-link distances above this (m) are reported as the cap (inactive rows).
@@ -168,7 +170,8 @@ class IpoptConfig:
         tol: Ipopt tolerance.
         obj_change_tol: Ipopt also stops ("acceptable") once the relative change of the path
             cost stays below this for 3 iterations at a feasible point (constraint violation
-            ≤ 1e-5): the certificate, not the KKT residual, judges the result.
+            ≤ 1e-5): the certificate, not the KKT residual, judges the result
+            (docs/decisions.md#ipopt-stop-on-path-cost-stagnation).
         options: extra Ipopt options (name → value, :data:`gdnplan.limits.IPOPT_OPTIONS`)
             over gdnplan's, e.g. ``{"limited_memory_initialization": "scalar1"}``.
     """

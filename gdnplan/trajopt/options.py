@@ -82,19 +82,17 @@ class TrajoptOptions:
             None: when the model provides per-link distances (coal does).
         interpolated: M check points strictly between consecutive waypoints (before refining);
             None: 2 for Ipopt, 3 for Adam; Ipopt adds one per restart (``_plan_ipopt``).
-            With 2 rather than 3 (the CCD certificate and refine rounds catch what the sparser
-            check points miss) Ipopt with GraphDistNet took 25 % less time on (d) (a network
-            pass costs about linearly in the check points) for +1 % mean path cost, 34 % less
-            on the fetch layouts, 20 % more on (b), all 20/20 (benchmarks/RESULTS.md). Adam's
-            stop test reads the check points alone, so Adam keeps the paper-baseline density.
+            2 for Ipopt: a network pass costs about linearly in the check points and the CCD
+            certificate and refine rounds catch what the sparser check points miss
+            (docs/decisions.md#ipopt-check-points-per-segment). Adam's stop test reads the
+            check points alone, so Adam keeps the paper-baseline density.
         starts: Ipopt attempts (new seed path each) before giving up.
         max_iter: Ipopt iteration cap per attempt.
         tol: Ipopt tolerance.
         obj_change_tol: Ipopt also stops ("acceptable") once the relative change of the path
             cost stays below this for 3 iterations at a feasible point (constraint violation
-            ≤ 1e-5): the certified check, not the KKT residual, judges the result. 1e-3 rather than
-            1e-4 cut the Ipopt iterations of the (d) problems by 15 % (GraphDistNet) and 23 %
-            (coal) for +0.1–0.3 % mean path cost (benchmarks/RESULTS.md).
+            ≤ 1e-5): the certified check, not the KKT residual, judges the result
+            (docs/decisions.md#ipopt-stop-on-path-cost-stagnation).
         clearance_buffer: the check points demand d ≥ max(margin, c + clearance_buffer) (m),
             c the problem's certified clearance (``Problem.certified_clearance``, the margin by
             default): Ipopt leaves active check points a hair inside their bound (d ≈ bound −
@@ -102,10 +100,8 @@ class TrajoptOptions:
             it, and the buffer also leaves the path room to bend between check points.
         learned_margin: removed; must be 0.
         raise_window: a refine round raises a learned model's margin on the rejected
-            segments and this many segments either side of each; None: on the whole path.
-            2 rather than the whole path: the fetch bring-out (one attempt, seeds 0–3)
-            certified 4/4 instead of 2/4, the (d) and fetch-layout problems stayed 20/20 with
-            the same median evaluations (benchmarks/RESULTS.md).
+            segments and this many segments either side of each; None: on the whole path
+            (docs/decisions.md#raise-window).
         rrt_clearance: extra clearance (m) above the margin demanded of seed paths (at most
             half the start's and goal's own clearance above the margin); when RRT-Connect finds
             no such path, the same attempt retries demanding the margin only (narrow passages).

@@ -65,8 +65,8 @@ class _Transcription:
         ipopt = {
             "hessian_approximation": "limited-memory",
             # L-BFGS's initial matrix σ I with σ = sᵀy / sᵀs of the last step (Ipopt's
-            # "scalar2"): on the (d) problems the line search then rarely backtracks, median
-            # 63 instead of 100 constraint evaluations with GraphDistNet (benchmarks/RESULTS.md)
+            # "scalar2"): the line search then rarely backtracks, so fewer constraint
+            # evaluations (docs/decisions.md#l-bfgs-initial-matrix)
             "limited_memory_initialization": "scalar2",
             "print_level": 0,
             "max_iter": opts.max_iter,
