@@ -377,3 +377,16 @@ def test_clearancenet_keeps_its_default_budget_and_preset_with_init_is_refused(
     assert (
         exit_.value.code == 2 and "--preset: does not apply with --init" in capsys.readouterr().err
     )
+
+
+def test_an_old_solver_table_warns_its_author_in_one_line_and_still_plans(tmp_path):
+    problem = tmp_path / "old.toml"
+    problem.write_text(
+        '[robot]\nname = "planar2"\n[scene]\ngenerator = "b"\nseed = 1\n'
+        "[start]\nq = [0.0, 0.0]\n[goal]\nq = [1.0, 1.0]\n[solver]\nrrt_time = 1.0\n"
+    )
+    proc = _cli("", "plan", str(problem), "--collision", "coal", "--json", "-q")
+    warning = "warning: problem file: the [solver] table is deprecated; move its keys: "
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.splitlines() == [warning + "rrt_time → [seed] rrt_time"]
+    assert json.loads(proc.stdout)["success"] is True  # stdout stays one JSON object

@@ -537,11 +537,12 @@ def test_deprecated_names_warn_naming_the_new_ones_and_plan_the_same(square):
 
 
 def test_old_solver_table_loads_into_the_new_configs_with_a_warning():
+    assert issubclass(FutureWarning, Warning) and not issubclass(FutureWarning, DeprecationWarning)
     old = _cfg(solver={"rrt_step": 0.3, "refine_rounds": 2, "interpolated": 3, "ipopt": {}})
-    with pytest.warns(DeprecationWarning, match=r"refine_rounds → \[refine\] rounds"):
-        problem = Problem.from_config(old)
+    with pytest.warns(FutureWarning, match=r"refine_rounds → \[refine\] rounds"):
+        problem = Problem.from_config(old)  # a user-facing deprecation: shown by default
     new = _cfg(seed={"rrt_step": 0.3}, refine={"rounds": 2}, ipopt={"interpolated": 3})
     assert problem.solver == Problem.from_config(new).solver
-    with pytest.warns(DeprecationWarning):
+    with pytest.warns(FutureWarning):
         adam = Problem.from_config(_cfg(solver={"adam_lr": 0.02, "interpolated": 2}))
     assert adam.solver.optimizer == AdamConfig(lr=0.02, interpolated=2)

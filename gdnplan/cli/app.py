@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 import traceback
+import warnings
 from typing import TYPE_CHECKING
 
 import typer
@@ -60,6 +61,7 @@ def run(args: list[str] | None = None) -> None:
     """Run the app on ``args`` (default: the command line); exits with the status of the module
     docstring, every error as one line on stderr."""
     _DEBUG["on"] = False
+    shown, warnings.showwarning = warnings.showwarning, _warning_line
     try:
         code = app(args=args, prog_name="gdnplan", standalone_mode=False)
         if code == EXIT_INTERRUPTED:  # typer returns Ctrl-C in a command as exit code 130
@@ -80,7 +82,13 @@ def run(args: list[str] | None = None) -> None:
         code = _fail(e, message, EXIT_INTERNAL)
     finally:
         hide_progress()
+        warnings.showwarning = shown
     sys.exit(code if isinstance(code, int) else 0)
+
+
+def _warning_line(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning the filters let through as one line ``warning: …`` on stderr."""
+    typer.echo(f"warning: {one_line(str(message))}", err=True)
 
 
 def _fail(e: BaseException, message: str, code: int) -> int:

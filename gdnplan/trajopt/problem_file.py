@@ -125,7 +125,7 @@ def plan_config_from_tables(cfg: dict) -> PlanConfig | None:
     """The PlanConfig of a file's ``[seed]``, ``[refine]``, ``[ipopt]`` and ``[adam]`` tables
     (None when it has none); an ``[adam]`` table picks the Adam optimiser (at most one of
     ``[ipopt]`` and ``[adam]``). A deprecated ``[solver]`` table is mapped key by key onto
-    them (:data:`~gdnplan.trajopt.options.OLD_KEYS`) with a DeprecationWarning."""
+    them (:data:`~gdnplan.trajopt.options.OLD_KEYS`) with a FutureWarning (shown by default)."""
     tables = {t: _table(cfg[t], t) for t in PLAN_TABLES if t in cfg}
     if "solver" in cfg:
         _merge_old_solver(_table(cfg["solver"], "solver"), tables)
@@ -191,7 +191,7 @@ def _merge_old_solver(old: dict, tables: dict[str, dict]) -> None:
         homes.append(f"{key} → [{table}] {new}")
     warnings.warn(
         f"problem file: the [solver] table is deprecated; move its keys: {', '.join(homes)}",
-        DeprecationWarning,
+        FutureWarning,  # for the file's author (Python shows it by default), not a developer
         stacklevel=4,
     )
 
