@@ -190,7 +190,8 @@ def _merge_old_solver(old: dict, tables: dict[str, dict]) -> None:
         tables.setdefault(table, {})[new] = value
         homes.append(f"{key} → [{table}] {new}")
     warnings.warn(
-        f"problem file: the [solver] table is deprecated; move its keys: {', '.join(homes)}",
+        "problem file: the [solver] table is deprecated; "
+        + (f"move its keys: {', '.join(homes)}" if homes else "it is empty: delete it"),
         FutureWarning,  # for the file's author (Python shows it by default), not a developer
         stacklevel=4,
     )
