@@ -31,6 +31,7 @@ checked distance, so the reported lower bound is at most ``tol`` below the path'
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 
@@ -161,16 +162,44 @@ def certify_path(
     """
     _check_args(margin, tol, min_splits, max_checks)
     robot = scene.robot
-    q_path = robot.check_q(q_path, "q_path")
+    return certify_by_bisection(
+        robot.check_q(q_path, "q_path"),
+        lambda q: signed_distance(scene, q),
+        lambda qa, qb: motion_bound(robot, qa, qb),
+        margin,
+        tol,
+        min_splits,
+        stop_early,
+        max_checks,
+    )
+
+
+def certify_by_bisection(
+    q_path: np.ndarray,
+    distance: Callable[[np.ndarray], np.ndarray],
+    motion: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    margin: float,
+    tol: float,
+    min_splits: int,
+    stop_early: bool,
+    max_checks: int,
+) -> Certificate:
+    """The bisection proof behind :func:`certify_path`, for any robot and distance.
+
+    ``distance(q)`` (B, dof) → (B,) is the exact signed distance (m) and ``motion(qa, qb)``
+    bounds how far any point of the robot moves between qa and qb (B, dof) → (B,) (m); a piece
+    is proven when (d_a + d_b − motion) / 2 > margin (and within ``tol`` of the smallest checked
+    distance), else it is bisected. Arguments are checked by the caller.
+    """
     qa, qb, seg = _initial_pieces(q_path, min_splits)
     nodes = np.concatenate([qa, qb[-1:]])
-    raw = signed_distance(scene, nodes)
+    raw = distance(nodes)
     d_nodes = proven_distance(raw)
     da, db = d_nodes[:-1], d_nodes[1:]
     n_checks, best, raw_min = len(nodes), float(np.min(d_nodes)), float(np.min(raw))
     lower, bad, reasons = math.inf, set(), []
     while len(qa):
-        delta = motion_bound(robot, qa, qb)
+        delta = motion(qa, qb)
         bound = (da + db - delta) / 2
         hit = (da <= margin) | (db <= margin)
         if hit.any():
@@ -192,7 +221,7 @@ def certify_path(
             break
         qa, qb, da, db, seg = qa[keep], qb[keep], da[keep], db[keep], seg[keep]
         mid = (qa + qb) / 2
-        raw = signed_distance(scene, mid) if len(mid) else np.zeros(0)
+        raw = distance(mid) if len(mid) else np.zeros(0)
         dm = proven_distance(raw)
         n_checks += len(mid)
         if len(dm):

@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from ..ccd import MIN_PIECE, Certificate, proven_distance
+from ..ccd import Certificate, certify_by_bisection
 from ..errors import InputError
 from ..limits import check_int, check_number
 from .distance3d import checker3d
@@ -81,49 +81,13 @@ def certify_path3d(
     if len(q_path) < 2:
         raise InputError("q_path: a path needs at least 2 waypoints")
     checker = checker3d(scene)
-    s = np.linspace(0.0, 1.0, min_splits + 1)
-    step = (q_path[1:] - q_path[:-1])[:, None]
-    qa = (q_path[:-1, None] + s[None, :-1, None] * step).reshape(-1, robot.dof)
-    qb = (q_path[:-1, None] + s[None, 1:, None] * step).reshape(-1, robot.dof)
-    qb[min_splits - 1 :: min_splits] = q_path[1:]
-    seg = np.repeat(np.arange(len(q_path) - 1), min_splits)
-    raw = checker.evaluate(np.concatenate([qa, qb[-1:]])).distance
-    d = proven_distance(raw)
-    da, db = d[:-1], d[1:]
-    n_checks, raw_min, lower = len(raw), float(raw.min()), math.inf
-    bad: set[int] = set()
-    reasons: list[str] = []
-    while len(qa):
-        delta = motion_bound3d(robot, qa, qb)
-        bound = (da + db - delta) / 2
-        hit = (da <= margin) | (db <= margin)
-        proven = ~hit & (bound > margin)
-        stuck = ~hit & ~proven & (delta < MIN_PIECE)
-        if hit.any():
-            bad.update(seg[hit].tolist())
-            reasons.append("a checked configuration is within the margin")
-        if stuck.any():
-            bad.update(seg[stuck].tolist())
-            reasons.append("a piece too small to bisect has no proof")
-        if proven.any():
-            lower = min(lower, float(bound[proven].min()))
-        keep = ~(hit | proven | stuck)
-        if n_checks + int(keep.sum()) > max_checks:
-            bad.update(seg[keep].tolist())
-            reasons.append(f"the check budget ({max_checks} evaluations) ran out")
-            break
-        qa, qb, da, db, seg = qa[keep], qb[keep], da[keep], db[keep], seg[keep]
-        if not len(qa):
-            break
-        mid = (qa + qb) / 2
-        raw = checker.evaluate(mid).distance
-        dm = proven_distance(raw)
-        n_checks, raw_min = n_checks + len(mid), min(raw_min, float(raw.min()))
-        qa, qb = np.concatenate([qa, mid]), np.concatenate([mid, qb])
-        da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
-        seg = np.concatenate([seg, seg])
-    ok = not bad
-    reason = "; ".join(dict.fromkeys(reasons))
-    return Certificate(
-        ok, lower if ok else -math.inf, raw_min, n_checks, tuple(sorted(bad)), reason
+    return certify_by_bisection(
+        q_path,
+        lambda q: checker.evaluate(q).distance,
+        lambda qa, qb: motion_bound3d(robot, qa, qb),
+        margin,
+        math.inf,  # prove the margin only
+        min_splits,
+        False,
+        max_checks,
     )
