@@ -18,16 +18,10 @@ from pathlib import Path
 
 from ..assets import robot_urdf
 from ..errors import InputError, UnknownNameError
+from ..ur5e.kinematics import JOINTS
 from .robot3d import Robot3D, robot3d_from_urdf
 
-UR5E_JOINTS = (
-    "shoulder_pan_joint",
-    "shoulder_lift_joint",
-    "elbow_joint",
-    "wrist_1_joint",
-    "wrist_2_joint",
-    "wrist_3_joint",
-)
+UR5E_JOINTS = JOINTS  # all six arm joints, as the planar model names them
 PANDA_JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
 
 
