@@ -3,26 +3,10 @@ from pathlib import Path
 import casadi
 import numpy as np
 import pytest
+from test_gradients import SmoothModel  # the stand-in model of the callback gradient tests
 
 import gdnplan as gp
 from gdnplan.casadi_bridge import DistanceCallback
-
-
-class SmoothModel:
-    """Stand-in differentiable DistanceModel: d(q) = 0.5 + Σ_j a_j sin(q_j + b_j)."""
-
-    name = "smooth"
-
-    def __init__(self, dof: int):
-        rng = np.random.default_rng(0)
-        self.a, self.b = rng.uniform(0.1, 0.3, dof), rng.uniform(0, 3, dof)
-
-    def distance(self, scene, q):
-        return 0.5 + np.sin(np.atleast_2d(q) + self.b) @ self.a
-
-    def distance_and_grad(self, scene, q):
-        q = np.atleast_2d(q)
-        return self.distance(scene, q), np.cos(q + self.b) * self.a
 
 
 def _functions(cb, size):
