@@ -62,6 +62,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d",
             "arm3d.distance3d",
             "arm3d.ccd3d",
+            "arm3d.ik3d",
             "path_metrics",
             "ompl_planner",
         ),
