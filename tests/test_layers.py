@@ -63,6 +63,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.distance3d",
             "arm3d.ccd3d",
             "arm3d.ik3d",
+            "arm3d.held",
             "path_metrics",
             "ompl_planner",
         ),

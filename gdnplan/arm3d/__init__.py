@@ -7,6 +7,7 @@ distance with self-collision and its gradient.
 * :mod:`gdnplan.arm3d.scene3d`: obstacles and :class:`Scene3D`.
 * :mod:`gdnplan.arm3d.distance3d`: signed distance, gradient, broad phase.
 * :mod:`gdnplan.arm3d.ccd3d`: the continuous certificate of joint paths.
+* :mod:`gdnplan.arm3d.held`: an object held by the tool frame (the fetch's stick).
 * :mod:`gdnplan.arm3d.ik3d`: end-effector pose IK (damped least squares, collision-free).
 """
 
@@ -22,6 +23,7 @@ from .distance3d import (
     signed_distance3d,
     signed_distance3d_and_grad,
 )
+from .held import hold
 from .ik3d import PoseIK, frame_pose, solve_pose_ik, tool_frame
 from .robot3d import LinkShape, Robot3D, robot3d_from_urdf
 from .scene3d import (
@@ -53,6 +55,7 @@ __all__ = [
     "convex_obstacle",
     "cylinder_obstacle",
     "frame_pose",
+    "hold",
     "lever_arms3d",
     "load_robot3d",
     "mesh_obstacle",
