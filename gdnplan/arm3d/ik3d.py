@@ -17,6 +17,10 @@ the limits: the same pose) and kept when its coal signed distance
 (:class:`gdnplan.arm3d.distance3d.Checker3D`, obstacles and self-collision) is at least
 ``margin``; :func:`solve_pose_ik` returns the kept solution closest to the reference (Euclidean
 in rad).
+
+:func:`cartesian_path` follows a sequence of tool positions at one rotation by continuation:
+each point is solved from the previous solution (its nearest), and a joint jump larger than
+``max_jump`` (a branch switch, not a continuous motion) fails it.
 """
 
 from __future__ import annotations
@@ -206,9 +210,49 @@ def solve_pose_ik(
     return PoseIK(q, pos, ang, d, attempts, len(found))
 
 
+def cartesian_path(
+    scene: Scene3D | Robot3D,
+    q0,
+    positions,
+    rotation,
+    margin: float = 0.0,
+    max_jump: float = 0.3,
+    frame: str | None = None,
+) -> np.ndarray:
+    """(K + 1, dof) joint path q0, q_1 … q_K through tool ``positions`` (K, 3) (m) at one
+    ``rotation``, each q_k the IK solution nearest q_{k−1} with clearance ≥ ``margin`` (m).
+
+    Raises InfeasibleProblemError naming the point when it has no clear solution within
+    ``max_jump`` (rad, largest joint change) of the previous one.
+    """
+    scene = scene if isinstance(scene, Scene3D) else Scene3D(scene)
+    q = [scene.robot.check_q(q0, "q0")[0]]
+    pts = np.asarray(positions, dtype=float).reshape(-1, 3)
+    for k, p in enumerate(pts):
+        sol = None
+        for restarts in (1, 8):
+            try:
+                sol = solve_pose_ik(
+                    scene, p, rotation, q[-1], frame, margin, restarts, solutions=1, seed=k
+                )
+            except InfeasibleProblemError:
+                continue
+            if np.abs(sol.q - q[-1]).max() <= max_jump:
+                break
+            sol = None
+        if sol is None:
+            raise InfeasibleProblemError(
+                f"cartesian path: point {k + 1}/{len(pts)} {np.round(p, 4).tolist()} m has no "
+                f"IK solution with clearance ≥ {margin} m within {max_jump} rad of the last"
+            )
+        q.append(sol.q)
+    return np.array(q)
+
+
 __all__ = [
     "TOOL_FRAMES",
     "PoseIK",
+    "cartesian_path",
     "frame_pose",
     "nearest_equivalent",
     "pose_target",
