@@ -6,8 +6,9 @@ Stages, from the configurations of :func:`gdnplan.arm3d.fetch3d_scene.fetch3d`:
 stage        motion                  gripper   how
 ============ ======================= ========= =========================================
 approach     q_home → q_pregrasp     open      planned (:func:`gdnplan.trajopt.plan`)
-reach_in     q_pregrasp → q_grasp    open      planned (the tcp's straight line through
-                                               the entrance exists: ``fetch.lines``)
+reach_in     q_pregrasp → q_grasp    open      planned, piece by piece between knots
+                                               0.1 m apart on the tcp's straight line
+                                               through the entrance (``fetch.lines``)
 grasp        q_grasp                 holding   the fingers close on the stick, which
                                                becomes a shape of the robot; it rests on
                                                its shelf (d = 0 by construction)
@@ -15,18 +16,20 @@ lift         q_grasp → q_lift        holding   scripted: the tcp rises LIFT = 
                                                straight line (pose IK), certified from its
                                                first point off the shelf (2 mm up)
 bring_out    q_lift → q_out          holding   planned, the stick back out through the
-                                               entrance
+                                               entrance, piece by piece between knots
 retreat      q_out → q_home          holding   planned
 ============ ======================= ========= =========================================
 
 Planned stages are :class:`gdnplan.trajopt.Problem` s on the stage's Scene3D with clearance
-``margin`` (m) and coal's exact distance; one succeeds when the coal certificate
-(:func:`gdnplan.arm3d.certify_path3d`) proves d > margin on the whole continuous path
-(obstacles and self-collision, the held stick included).
+``margin`` (m) and coal's exact distance (:func:`stage_problems`); a piece succeeds when the
+coal certificate (:func:`gdnplan.arm3d.certify_path3d`) proves d > margin on its whole
+continuous path (obstacles and self-collision, the held stick included), a stage when every
+piece does (the pieces share their ends, so the stage's path is certified).
 """
 
 from __future__ import annotations
 
+import itertools
 import logging
 import time
 from dataclasses import dataclass
@@ -53,6 +56,7 @@ PLANNED = {  # stage → (scene, start, goal)
 }
 RESTING_CONTACT_TOL = 1e-9  # m: the stick on its shelf is contact, not penetration
 WAYPOINTS = 30
+KNOT_STEP = 10  # points of a straight tool line (LINE_STEP = 0.01 m apart) between knots
 MARGIN = 0.01  # m: clearance of the planned stages
 # the held stick threads the entrance: short RRT-Connect steps with more time (as the planar
 # fetch's bring-out); the other stages use the planner's defaults
@@ -103,28 +107,54 @@ class Stage3D:
         }
 
 
-def stage_problem(fetch: Fetch3D, name: str, margin: float = MARGIN) -> Problem:
-    """The planning problem of a planned stage (approach, reach_in, bring_out, retreat)."""
+def knots(fetch: Fetch3D, name: str) -> list[np.ndarray]:
+    """The configurations a planned stage passes: start, the knots of its straight tool line
+    (reach_in, bring_out: every KNOT_STEP points of ``fetch.lines``), goal."""
+    _, start, goal = PLANNED[name]
+    if name not in fetch.lines:
+        return [fetch.q[start], fetch.q[goal]]
+    line = fetch.lines[name]
+    inner = list(line[KNOT_STEP:-1:KNOT_STEP])
+    if inner and np.linalg.norm(line[-1] - inner[-1]) < 1e-9:
+        inner.pop()
+    return [fetch.q[start], *inner, fetch.q[goal]]
+
+
+def stage_problems(fetch: Fetch3D, name: str, margin: float = MARGIN) -> list[Problem]:
+    """The planning problems of a planned stage (approach, reach_in, bring_out, retreat): one
+    for approach and retreat, one per piece between consecutive :func:`knots` for the stages
+    along a straight tool line (the pieces are short, so their joint-space lines stay near the
+    tool line and the planner's straight-line check or a short RRT-Connect solves them)."""
     if name not in PLANNED:
         raise InputError(f"stage: {name!r} is not planned; planned stages: {list(PLANNED)}")
-    state, start, goal = PLANNED[name]
-    return Problem(
-        scene=fetch.scenes[state],
-        start=fetch.q[start],
-        goal=fetch.q[goal],
-        waypoints=WAYPOINTS,
-        margin=margin,
-        solver=STAGE_SOLVERS.get(name),
-    )
+    scene = fetch.scenes[PLANNED[name][0]]
+    points = knots(fetch, name)
+    return [
+        Problem(
+            scene=scene,
+            start=a,
+            goal=b,
+            waypoints=WAYPOINTS,
+            margin=margin,
+            solver=STAGE_SOLVERS.get(name),
+        )
+        for a, b in itertools.pairwise(points)
+    ]
 
 
 def _planned(fetch: Fetch3D, name: str, margin: float) -> Stage3D:
-    problem = stage_problem(fetch, name, margin)
-    r = plan(problem, collision="coal")
-    state = PLANNED[name][0]
-    return Stage3D(
-        name, state, problem.scene, r.q, r.success, r.min_distance, r.solve_time, True, r.reason
-    )
+    """Plan every piece of a stage; the stage succeeds when every piece is certified."""
+    t0 = time.perf_counter()
+    problems = stage_problems(fetch, name, margin)
+    runs = [plan(p, collision="coal") for p in problems]
+    ok = all(r.success for r in runs)
+    q = np.vstack([runs[0].q, *(r.q[1:] for r in runs[1:])])
+    lower = min(r.min_distance for r in runs) if ok else -np.inf
+    reasons = dict.fromkeys(r.reason for r in runs)
+    detail = "; ".join(reasons) if len(runs) == 1 else f"{len(runs)} pieces: " + "; ".join(reasons)
+    scene = problems[0].scene
+    dt = time.perf_counter() - t0
+    return Stage3D(name, PLANNED[name][0], scene, q, ok, lower, dt, True, detail)
 
 
 def _grasp(fetch: Fetch3D) -> Stage3D:
@@ -178,4 +208,4 @@ def run_fetch3d(
     return out
 
 
-__all__ = ["MARGIN", "PLANNED", "STAGES", "Stage3D", "run_fetch3d", "stage_problem"]
+__all__ = ["MARGIN", "PLANNED", "STAGES", "Stage3D", "knots", "run_fetch3d", "stage_problems"]
