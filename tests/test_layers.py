@@ -77,7 +77,17 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
     (
         "paper reproduction",
-        ("env_models", "evaluate", "table2", "fetch", "arm3d.fetch3d", "viz", "viz3d", "viz3d.*"),
+        (
+            "env_models",
+            "evaluate",
+            "table2",
+            "fetch",
+            "arm3d.fetch3d",
+            "arm3d.fetch3d_files",
+            "viz",
+            "viz3d",
+            "viz3d.*",
+        ),
     ),
     ("cli", ("cli", "cli.*", "__init__")),
 ]

@@ -28,14 +28,39 @@ def fetch_command(
     threads: int = typer.Option(1, help=THREADS_HELP),
     view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
+    three_d: bool = typer.Option(
+        False, "--3d", help="The 3-D fetch: the full six-joint UR5e, exact coal distances."
+    ),
+    placement: str = typer.Option(
+        None, help="--3d: the storage's front-face centre and yaw 'x,y,yaw' (m, m, rad)."
+    ),
+    write_problems: Path = typer.Option(
+        None, help="--3d: write each planned stage's problem files into this directory."
+    ),
 ) -> None:
     """The UR5e fetch: approach, reach in, grasp, lift, bring the stick out, retreat.
 
     Exit status: 0 when every stage is certified collision-free, 1 otherwise, 2 on bad input.
     """
+    from ..errors import InputError
     from ..fetch import run_fetch
 
     show_progress(not quiet)
+    if three_d:
+        planar_only = {"--animate": animate, "--view3d": view3d, "--weights": weights}
+        planar_only["--collision"] = collision not in ("graphdistnet", "coal") and collision
+        for flag, value in planar_only.items():
+            if value:
+                raise InputError(f"{flag}: the 3-D fetch does not take it (coal distances only)")
+        from .fetch3d import run_fetch3d_command
+
+        set_threads(threads)
+        if not run_fetch3d_command(seed, placement, json_output, write_problems):
+            raise typer.Exit(1)
+        return
+    for flag, value in (("--placement", placement), ("--write-problems", write_problems)):
+        if value is not None:
+            raise InputError(f"{flag}: only the 3-D fetch takes it (add --3d)")
     if animate is not None:
         check_output_path(animate, (".gif",), "--animate")
     set_threads(threads)
