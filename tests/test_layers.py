@@ -46,6 +46,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.robot3d",
             "arm3d.builtin",
             "arm3d.scene3d",
+            "arm3d.storage3d",  # the 3-D fetch storage: boxes and tool poses, no distances
         ),
     ),
     (
@@ -62,6 +63,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d",
             "arm3d.distance3d",
             "arm3d.ccd3d",
+            "arm3d.ik3d",
+            "arm3d.held",
+            "arm3d.fetch3d_scene",
             "path_metrics",
             "ompl_planner",
         ),
@@ -73,7 +77,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
     (
         "paper reproduction",
-        ("env_models", "evaluate", "table2", "fetch", "viz", "viz3d", "viz3d.*"),
+        ("env_models", "evaluate", "table2", "fetch", "arm3d.fetch3d", "viz", "viz3d", "viz3d.*"),
     ),
     ("cli", ("cli", "cli.*", "__init__")),
 ]

@@ -7,6 +7,8 @@ distance with self-collision and its gradient.
 * :mod:`gdnplan.arm3d.scene3d`: obstacles and :class:`Scene3D`.
 * :mod:`gdnplan.arm3d.distance3d`: signed distance, gradient, broad phase.
 * :mod:`gdnplan.arm3d.ccd3d`: the continuous certificate of joint paths.
+* :mod:`gdnplan.arm3d.held`: an object held by the tool frame (the fetch's stick).
+* :mod:`gdnplan.arm3d.ik3d`: end-effector pose IK (damped least squares, collision-free).
 """
 
 from __future__ import annotations
@@ -21,6 +23,8 @@ from .distance3d import (
     signed_distance3d,
     signed_distance3d_and_grad,
 )
+from .held import hold
+from .ik3d import PoseIK, frame_pose, solve_pose_ik, tool_frame
 from .robot3d import LinkShape, Robot3D, robot3d_from_urdf
 from .scene3d import (
     Obstacle3D,
@@ -41,6 +45,7 @@ __all__ = [
     "Distances3D",
     "LinkShape",
     "Obstacle3D",
+    "PoseIK",
     "Robot3D",
     "Scene3D",
     "box_obstacle",
@@ -49,6 +54,8 @@ __all__ = [
     "checker3d",
     "convex_obstacle",
     "cylinder_obstacle",
+    "frame_pose",
+    "hold",
     "lever_arms3d",
     "load_robot3d",
     "mesh_obstacle",
@@ -59,5 +66,7 @@ __all__ = [
     "robot3d_names",
     "signed_distance3d",
     "signed_distance3d_and_grad",
+    "solve_pose_ik",
     "sphere_obstacle",
+    "tool_frame",
 ]

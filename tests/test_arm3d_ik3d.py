@@ -1,0 +1,106 @@
+"""Pose IK of 3-D robots: round trips through Pinocchio's forward kinematics on random reachable
+poses, collision-free solutions at the margin, the nearest to the reference, clear errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gdnplan.arm3d import Scene3D, box_obstacle, checker3d, load_robot3d
+from gdnplan.arm3d.ik3d import frame_pose, solve_pose_ik, tool_frame
+from gdnplan.errors import InfeasibleProblemError, InputError
+
+
+def _fk(robot, q, frame):
+    """World pose of a frame from Pinocchio directly (independent of ik3d's helpers)."""
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return data.oMf[robot.model.getFrameId(frame)]
+
+
+@pytest.mark.parametrize("name", ["ur5e", "panda"])
+@given(seed=st.integers(0, 10_000))
+@settings(max_examples=6, deadline=None)
+def test_round_trip_on_random_reachable_poses(name, seed):
+    robot = load_robot3d(name)
+    q_true = robot.random_configurations(1, np.random.default_rng(seed))[0]
+    target = _fk(robot, q_true, tool_frame(robot))
+    quat = pin.Quaternion(target.rotation).coeffs()  # (x, y, z, w)
+    sol = solve_pose_ik(robot, target.translation, quat, margin=-1.0, seed=seed)
+    got = _fk(robot, sol.q, tool_frame(robot))
+    assert np.linalg.norm(got.translation - target.translation) < 1e-4
+    assert np.abs(got.rotation - target.rotation).max() < 1e-3
+    assert robot.within_limits(sol.q)[0]
+    assert sol.position_error < 1e-4 and sol.rotation_error < 1e-3
+
+
+def test_the_tool_frame_is_the_gripper_tcp_between_the_fingers():
+    robot = load_robot3d("ur5e")
+    q = np.array([0.3, -1.2, 1.4, -1.6, -1.57, 0.2])
+    tcp = frame_pose(robot, q).translation
+    fingers = [_fk(robot, q, f).translation for f in ("left_finger_link", "right_finger_link")]
+    gripper = _fk(robot, q, "gripper_base_link")
+    axis = gripper.rotation[:, 2]
+    # the tcp lies on the tool axis, halfway along the fingers (0.08 m body + 0.025 m)
+    assert np.allclose(tcp, gripper.translation + 0.105 * axis, atol=1e-9)
+    assert np.allclose((fingers[0] + fingers[1]) / 2 + 0.025 * axis, tcp, atol=1e-9)
+
+
+def test_the_solution_is_the_one_nearest_the_reference():
+    robot = load_robot3d("ur5e")
+    q_ref = np.array([0.2, -1.3, 1.5, -1.8, -1.57, 0.4])
+    target = _fk(robot, q_ref, "gripper_tcp")
+    sol = solve_pose_ik(robot, target.translation, target.rotation, reference=q_ref)
+    assert np.allclose(sol.q, q_ref, atol=1e-4)  # other branches reach it too, but farther
+
+
+def test_solutions_keep_the_margin_from_obstacles():
+    robot = load_robot3d("ur5e")
+    q = np.array([0.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    target = _fk(robot, q, "gripper_tcp")
+    # a box right under the forearm of q: q itself is too close, another branch must be found
+    elbow = _fk(robot, q, "forearm_link").translation
+    scene = Scene3D(robot, [box_obstacle((0.1, 0.1, 0.1), elbow + np.array([0, 0, -0.12]))])
+    assert checker3d(scene).evaluate(q).distance[0] < 0.05
+    sol = solve_pose_ik(scene, target.translation, target.rotation, reference=q, margin=0.05)
+    assert checker3d(scene).evaluate(sol.q).distance[0] >= 0.05
+    assert np.isclose(sol.distance, checker3d(scene).evaluate(sol.q).distance[0])
+    assert np.linalg.norm(frame_pose(robot, sol.q).translation - target.translation) < 1e-4
+
+
+@pytest.mark.parametrize("name", ["ur5e", "panda"])
+def test_a_pose_out_of_reach_is_infeasible(name):
+    robot = load_robot3d(name)
+    with pytest.raises(InfeasibleProblemError, match="out of reach"):
+        solve_pose_ik(robot, [1.8, 0.3, 0.5], restarts=16)
+
+
+def test_a_pose_every_solution_of_which_collides_is_infeasible():
+    robot = load_robot3d("ur5e")
+    q = np.array([0.0, -1.2, 1.5, -1.9, -1.57, 0.0])
+    target = _fk(robot, q, "gripper_tcp")
+    scene = Scene3D(robot, [box_obstacle((0.2, 0.2, 0.2), target.translation)])  # around the tcp
+    with pytest.raises(InfeasibleProblemError, match="none with clearance"):
+        solve_pose_ik(scene, target.translation, target.rotation, restarts=16)
+
+
+@pytest.mark.parametrize(
+    "rotation",
+    [np.diag([1.0, 1.0, -1.0]), 2 * np.eye(3), [0, 0, 0, 0], [[1, 0], [0, 1]], [np.nan, 0, 0, 1]],
+)
+def test_an_orientation_that_is_not_a_rotation_is_an_input_error(rotation):
+    with pytest.raises(InputError, match="rotation"):
+        solve_pose_ik(load_robot3d("ur5e"), [0.4, 0.1, 0.3], rotation)
+
+
+def test_bad_positions_frames_and_references_are_input_errors():
+    robot = load_robot3d("ur5e")
+    with pytest.raises(InputError, match="position"):
+        solve_pose_ik(robot, [0.4, np.inf, 0.3])
+    with pytest.raises(InputError, match="frame"):
+        solve_pose_ik(robot, [0.4, 0.1, 0.3], frame="no_such_frame")
+    with pytest.raises(InputError, match="reference"):
+        solve_pose_ik(robot, [0.4, 0.1, 0.3], reference=np.zeros(5))
