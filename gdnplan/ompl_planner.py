@@ -24,9 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ccd import Certificate, certify_path, proven_distance
-from .distance import signed_distance
+from .ccd import Certificate, proven_distance
 from .errors import InputError
+from .exact import certify, exact_distance
 from .limits import check_number
 from .rrt import edge_free
 from .scene import Scene
@@ -104,7 +104,7 @@ def _setup(ob, scene: Scene, lower: np.ndarray, upper: np.ndarray, clearance: fl
         q = vector(state)
         if np.any(q < lower) or np.any(q > upper):
             return False
-        return bool(proven_distance(signed_distance(scene, q))[0] > clearance)
+        return bool(proven_distance(exact_distance(scene, q))[0] > clearance)
 
     class CertifiedMotion(ob.MotionValidator):
         def checkMotion(self, a, b) -> bool:  # OMPL's name
@@ -180,7 +180,7 @@ def plan_ompl(
     path = np.array([vector(sol.getState(i)) for i in range(sol.getStateCount())])
     path[0], path[-1] = start, goal  # OMPL's goal test is exact for a state goal
     elapsed = time.perf_counter() - t0
-    cert = certify_path(scene, path, margin=clearance)
+    cert = certify(scene, path, margin=clearance)
     return OmplResult(cert.ok, path, elapsed, planner, status, cert.lower_bound, cert)
 
 

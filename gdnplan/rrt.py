@@ -1,8 +1,8 @@
 """Seed paths: RRT-Connect in joint space on certified coal edge checks, shortcut, resample.
 
-Edges are straight joint-space segments accepted only when :func:`gdnplan.ccd.certify_path`
-certifies them at the clearance asked for, so a seed path is collision-free as a continuous
-motion, not only at its vertices.
+Edges are straight joint-space segments accepted only when the scene's certificate
+(:func:`gdnplan.exact.certify`: planar or 3-D) certifies them at the clearance asked for, so a
+seed path is collision-free as a continuous motion, not only at its vertices.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ccd import certify_path, motion_bound
 from .errors import InputError
+from .exact import certify, motion_bound_of
 from .scene import Scene
 
 
@@ -30,7 +30,7 @@ class RRTResult:
 
 def edge_free(scene: Scene, qa: np.ndarray, qb: np.ndarray, clearance: float) -> bool:
     """True when the segment qa -> qb (dof,) is certified to stay above ``clearance`` (m)."""
-    cert = certify_path(
+    cert = certify(
         scene, np.stack([qa, qb]), margin=clearance, tol=np.inf, min_splits=1, stop_early=True
     )
     return cert.ok
@@ -180,7 +180,7 @@ def resample(robot, path: np.ndarray, n: int) -> np.ndarray:
     n ≥ K and spacing the others evenly by the motion bound (how far the robot moves)."""
     if len(path) == 1:
         return np.repeat(path, n, 0)
-    length = motion_bound(robot, path[:-1], path[1:]) + 1e-12  # (K-1,)
+    length = motion_bound_of(robot, path[:-1], path[1:]) + 1e-12  # (K-1,)
     if n < len(path):
         s = np.concatenate([[0.0], np.cumsum(length)])
         targets = np.linspace(0.0, s[-1], n)

@@ -377,7 +377,9 @@ def plan_timing(
 
     None for a failed plan, and for a robot whose URDF lacks velocity limits when no
     ``max_velocity`` is given (the note says which joint). ``max_acceleration`` selects the
-    ``smooth`` curve certified in ``scene`` (or ``stop``), see :func:`time_path`.
+    ``smooth`` curve certified in ``scene`` (or ``stop``), see :func:`time_path`; the curve
+    certificate is planar, so a 3-D scene gets ``stop`` (the certified polygon, at rest at
+    every waypoint).
     """
     if not success:
         return None, ""
@@ -385,7 +387,8 @@ def plan_timing(
         v = urdf_velocity(scene.robot) if max_velocity is None else max_velocity
     except InputError as e:
         return None, f"no timing: {e}"
-    return time_path(q, v, max_acceleration, scene if max_acceleration is not None else None), ""
+    curve_scene = scene if isinstance(scene, Scene) and max_acceleration is not None else None
+    return time_path(q, v, max_acceleration, curve_scene), ""
 
 
 __all__ = [

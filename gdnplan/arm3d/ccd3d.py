@@ -24,19 +24,31 @@ budget spent — never an acceptance without a proof. Self-collision is included
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 
 from ..ccd import Certificate, certify_by_bisection
 from ..errors import InputError
-from ..limits import check_int, check_number
+from ..limits import check_int, check_number, is_number
 from .distance3d import checker3d
 from .robot3d import Robot3D
 from .scene3d import Scene3D
 
+_ARMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # robot -> its lever arms
+
 
 def lever_arms3d(robot: Robot3D) -> np.ndarray:
-    """(S, dof) bounds r_{σ,j} ≥ |p − o_j| for every point p of shape σ, any q (m)."""
+    """(S, dof) bounds r_{σ,j} ≥ |p − o_j| for every point p of shape σ, any q (m); computed
+    once per robot (the certificate asks for them on every bisection round)."""
+    if robot not in _ARMS:
+        arms = _lever_arms3d(robot)
+        arms.setflags(write=False)
+        _ARMS[robot] = arms
+    return _ARMS[robot]
+
+
+def _lever_arms3d(robot: Robot3D) -> np.ndarray:
     model = robot.model
     hop = np.array(
         [np.linalg.norm(model.jointPlacements[i].translation) for i in range(model.njoints)]
@@ -67,15 +79,22 @@ def certify_path3d(
     margin: float = 0.0,
     min_splits: int = 4,
     max_checks: int = 20_000,
+    tol: float = math.inf,
+    stop_early: bool = False,
 ) -> Certificate:
     """Prove that the piecewise-linear joint path q_path (K, dof) keeps the exact signed
     distance (obstacles and self-collision) above ``margin`` (m) on the whole continuous path.
 
-    Returns a :class:`gdnplan.ccd.Certificate`; ``ok`` only with a proof on every piece.
+    ``tol`` (m): also bisect until the reported lower bound is within ``tol`` of the smallest
+    checked distance (inf: prove the margin only); ``stop_early``: return at the first
+    configuration within the margin. Returns a :class:`gdnplan.ccd.Certificate`; ``ok`` only
+    with a proof on every piece.
     """
     check_number(margin, "margin")
     check_int(min_splits, "min_splits", 1, 10**6)
     check_int(max_checks, "max_checks", 1, 10**9)
+    if not (is_number(tol) and tol > 0):
+        raise InputError(f"tol: expected a number > 0 (m) or inf, got {tol!r}")
     robot = scene.robot
     q_path = robot.check_q(q_path, "q_path")
     if len(q_path) < 2:
@@ -86,8 +105,8 @@ def certify_path3d(
         lambda q: checker.evaluate(q).distance,
         lambda qa, qb: motion_bound3d(robot, qa, qb),
         margin,
-        math.inf,  # prove the margin only
+        tol,
         min_splits,
-        False,
+        bool(stop_early),
         max_checks,
     )

@@ -38,6 +38,7 @@ import coal
 import numpy as np
 
 from ..errors import InputError
+from .fk3d import shape_placements_batch
 from .robot3d import point_jacobians
 from .scene3d import Scene3D
 
@@ -130,11 +131,18 @@ class Checker3D:
     # ------------------------------------------------------------------ one configuration
     def placements(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World placements (S, 4, 4) of the robot shapes and pair lower bounds b (P,) (m)."""
-        tf = self.robot.shape_placements(q)
-        centers = np.einsum("sij,sj->si", tf[:, :3, :3], self.shape_center) + tf[:, :3, 3]
+        tf, bounds = self.placements_batch(np.asarray(q, float)[None])
+        return tf[0], bounds[0]
+
+    def placements_batch(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(B, S, 4, 4) shape placements and (B, P) pair lower bounds b (m) of q (B, dof), in
+        numpy for the whole batch (:mod:`gdnplan.arm3d.fk3d`)."""
+        tf = shape_placements_batch(self.robot, q)
+        centers = np.einsum("bsij,sj->bsi", tf[..., :3, :3], self.shape_center) + tf[..., :3, 3]
         m = self.n_obstacle_pairs
-        other = np.concatenate([self.obs_center[self.pair_b[:m]], centers[self.pair_b[m:]]])
-        gap = np.linalg.norm(centers[self.pair_a] - other, axis=1)
+        obstacles = np.broadcast_to(self.obs_center[self.pair_b[:m]], (len(q), m, 3))
+        other = np.concatenate([obstacles, centers[:, self.pair_b[m:]]], axis=1)
+        gap = np.linalg.norm(centers[:, self.pair_a] - other, axis=2)
         return tf, gap - self.radius_sum
 
     def pair(self, k: int, tf: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
@@ -172,11 +180,14 @@ class Checker3D:
         r_a = self.shape_radius[a]
         return d, ca + r_a * n, ca + (r_a + d) * n, n
 
-    def scan(self, q: np.ndarray, per_link: bool, cap: float, broad_phase: bool):
+    def scan(self, q: np.ndarray, per_link: bool, cap: float, broad_phase: bool, placed=None):
         """Minimising pairs of one configuration: (targets T; T = 1 or L) arrays of distance,
-        pair, p₁, p₂, n, and the number of narrow-phase calls."""
+        pair, p₁, p₂, n, and the number of narrow-phase calls; ``placed``: its (placements,
+        bounds) when already computed (:meth:`placements_batch`)."""
         n_targets = self.robot.n_links if per_link else 1
-        tf, bounds = self.placements(q)
+        tf, bounds = self.placements(q) if placed is None else placed
+        if broad_phase and not per_link:
+            return self._scan_min(tf, bounds, cap)
         best = np.full(n_targets, cap, dtype=float)
         pair = np.full(n_targets, -1, dtype=int)
         p1, p2, nrm = (np.zeros((n_targets, 3)) for _ in range(3))
@@ -196,6 +207,22 @@ class Checker3D:
                 if d < best[t]:
                     best[t], pair[t], p1[t], p2[t], nrm[t] = d, k, a, b, n
         return best, pair, p1, p2, nrm, narrow
+
+    def _scan_min(self, tf: np.ndarray, bounds: np.ndarray, cap: float):
+        """:meth:`scan` of the overall minimum with the broad phase (the certificate's and the
+        seeds' call): the same pairs in the same order, on Python floats."""
+        best, arg, narrow = cap, -1, 0
+        witness = (np.zeros(3), np.zeros(3), np.zeros(3))
+        below = np.flatnonzero(bounds < cap)
+        for k in below[np.argsort(bounds[below], kind="stable")].tolist():
+            if bounds[k] >= best:
+                break  # sorted: no later pair can lower the minimum
+            d, a, b, n = self.pair(k, tf)
+            narrow += 1
+            if d < best:
+                best, arg, witness = d, k, (a, b, n)
+        a, b, n = witness
+        return np.array([best]), np.array([arg]), a[None], b[None], n[None], narrow
 
     def gradient(self, q: np.ndarray, pair: np.ndarray, p1, p2, normal) -> np.ndarray:
         """(T, dof) gradients nᵀ(J(p₂) − J(p₁)) of the minimising pairs (0 where pair = −1)."""
@@ -228,7 +255,10 @@ class Checker3D:
         """Signed distances (and gradients) of configurations q (B, dof) or (dof,) in rad."""
         q = self.robot.check_q(q)
         cap = _check_cap(cap)
-        rows = [self.scan(qi, per_link, cap, broad_phase) for qi in q]
+        tf, bounds = self.placements_batch(q)
+        rows = [
+            self.scan(qi, per_link, cap, broad_phase, (tf[i], bounds[i])) for i, qi in enumerate(q)
+        ]
         dist = np.array([r[0] for r in rows])
         pair = np.array([r[1] for r in rows])
         p1, p2, nrm = (np.array([r[i] for r in rows]) for i in (2, 3, 4))
@@ -254,10 +284,10 @@ class Checker3D:
         cap = _check_cap(cap)
         out = np.full((len(q), self.n_pairs), cap)
         narrow = np.zeros(len(q), dtype=int)
-        for i, qi in enumerate(q):
-            tf, bounds = self.placements(qi)
-            for k in np.flatnonzero(bounds < cap):
-                out[i, k] = min(self.pair(k, tf)[0], cap)
+        tf, bounds = self.placements_batch(q)
+        for i in range(len(q)):
+            for k in np.flatnonzero(bounds[i] < cap):
+                out[i, k] = min(self.pair(k, tf[i])[0], cap)
                 narrow[i] += 1
         return out, narrow
 

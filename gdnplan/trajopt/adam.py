@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 
-from ..ccd import certify_path
+from ..exact import certify
 from ..models import DistanceModel
 from .check_points import _interpolation_matrix, distance_bounds, straight_line
 from .config import PlanConfig
@@ -69,7 +69,7 @@ def _plan_adam(
         calls += 1
         if np.all(d >= lower + opts.stop):
             clearance = problem.certified_clearance
-            cert = certify_path(problem.scene, q, clearance) if refine.ccd else None
+            cert = certify(problem.scene, q, clearance) if refine.ccd else None
             if cert is None or cert.ok or refinements == refine.rounds:
                 status = "adam: cost below threshold"
                 break

@@ -7,10 +7,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..distance import signed_distance
+from ..arm3d.distance3d import Coal3DModel
+from ..exact import exact_distance
 from ..models import CoalModel, DistanceModel
-from ..scene import Scene
 from .problem import Problem
+
+
+def is_exact(model: DistanceModel) -> bool:
+    """True for the exact coal models (planar :class:`~gdnplan.models.CoalModel`, 3-D
+    :class:`~gdnplan.arm3d.Coal3DModel`): no learned error to allow for."""
+    return isinstance(model, (CoalModel, Coal3DModel))
 
 
 def straight_line(start: np.ndarray, goal: np.ndarray, n: int) -> np.ndarray:
@@ -69,7 +75,7 @@ def constraint_margin(problem: Problem, buffer: float) -> float:
 
 
 def model_overestimate(
-    scene: Scene, model: DistanceModel, q: np.ndarray, segments: list[int], margin: float
+    scene, model: DistanceModel, q: np.ndarray, segments: list[int], margin: float
 ) -> float:
     """How much a learned model overestimates the distance where coal finds the path too close.
 
@@ -78,7 +84,7 @@ def model_overestimate(
     """
     t = np.linspace(0.0, 1.0, 21)[:, None]
     points = np.concatenate([q[i] + t * (q[i + 1] - q[i]) for i in segments])
-    d_coal = signed_distance(scene, points)
+    d_coal = exact_distance(scene, points)
     close = d_coal < margin
     if not close.any():
         return 0.005
@@ -110,7 +116,7 @@ def distance_bounds(
     (docs/decisions.md#endpoint-relaxed-bounds-adam-only).
     """
     bounds = np.full(int(np.sum(splits)) + 1, margin)
-    if isinstance(model, CoalModel):
+    if is_exact(model):
         return bounds
     d_ends = model.distance(problem.scene, np.stack([problem.start, goal]))
     first, last = slice(0, int(splits[0])), slice(len(bounds) - 1 - int(splits[-1]), None)

@@ -12,13 +12,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..casadi_bridge import supports_per_link
-from ..ccd import certify_path
-from ..distance import signed_distance
-from ..models import CoalModel, DistanceModel
+from ..exact import certify, exact_distance
+from ..models import DistanceModel
 from .check_points import (
     _check_point_raise,
     _near_segments,
     constraint_margin,
+    is_exact,
     model_overestimate,
     straight_line,
 )
@@ -37,12 +37,12 @@ def _line_free(problem: Problem, line: np.ndarray) -> bool:
     """The straight line (T, dof) respects the step bound and is certified at the margin."""
     if np.max(np.abs(np.diff(line, axis=0))) > problem.max_step:
         return False
-    return certify_path(problem.scene, line, problem.margin, tol=np.inf, stop_early=True).ok
+    return certify(problem.scene, line, problem.margin, tol=np.inf, stop_early=True).ok
 
 
 def _seed_clearance(problem: Problem, goal: np.ndarray, extra: float) -> float:
     """Seed edges clear margin + extra, but never more than half the ends' own spare room."""
-    ends = float(np.min(signed_distance(problem.scene, np.stack([problem.start, goal]))))
+    ends = float(np.min(exact_distance(problem.scene, np.stack([problem.start, goal]))))
     return problem.margin + min(extra, (ends - problem.margin) / 2)
 
 
@@ -153,7 +153,7 @@ def _solve_refined(
     splits = np.full(problem.waypoints - 1, ipopt.interpolated + 1)
     per_link = supports_per_link(model) if ipopt.per_link is None else ipopt.per_link
     ipopt = replace(ipopt, per_link=per_link)
-    learned = not isinstance(model, CoalModel)
+    learned = not is_exact(model)
     margin = constraint_margin(problem, refine.clearance_buffer)  # above the certified clearance
     raised = np.zeros(len(splits))  # margin raise of each segment (m)
     q, duals, stats = guess, None, {"return_status": "time budget ended"}
@@ -177,7 +177,7 @@ def _solve_refined(
         if status in SOLVER_ERRORS or status.startswith("exception"):
             run.verified = None  # q is not a solver iterate: never accept it
             return q, stats, False
-        cert = certify_path(problem.scene, q, margin=problem.certified_clearance)
+        cert = certify(problem.scene, q, margin=problem.certified_clearance)
         run.verified = cert
         if cert.ok:
             return q, stats, True

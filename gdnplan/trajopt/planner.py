@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arm3d.distance3d import Coal3DModel
+from ..arm3d.scene3d import Scene3D
 from ..assets import default_weights
 from ..distance import signed_distance
 from ..errors import InfeasibleProblemError, InputError
@@ -29,8 +31,13 @@ from .result import Plan, _finish
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
 
-def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | Path | None):
+def resolve_model(
+    collision: str | DistanceModel, scene: Scene | Scene3D, weights: str | Path | None
+):
     """The DistanceModel named by ``collision`` ("coal", "graphdistnet" or a model instance).
+
+    "coal" is the scene kind's exact model: :class:`~gdnplan.models.CoalModel` for a planar
+    scene, :class:`~gdnplan.arm3d.Coal3DModel` for a 3-D one (no learned 3-D weights ship yet).
 
     ``weights`` (GraphDistNet): shipped weights by name (``"d"``) or a ``.safetensors`` path;
     None picks the shipped weights for the scene's robot and obstacles
@@ -44,9 +51,14 @@ def resolve_model(collision: str | DistanceModel, scene: Scene, weights: str | P
             )
         return checked(collision, scene)
     if collision == "coal":
-        return CoalModel()
+        return Coal3DModel() if isinstance(scene, Scene3D) else CoalModel()
     if collision != "graphdistnet":
         raise InputError(f"collision: unknown {collision!r}; choose 'coal' or 'graphdistnet'")
+    if isinstance(scene, Scene3D) and weights is None:
+        raise InputError(
+            "collision: no learned 3-D distance model ships yet; use collision='coal' (or give "
+            "3-D weights)"
+        )
     t0 = time.perf_counter()
     name = default_weights(scene) if weights is None else weights
     model = checked(load_model(name), scene)

@@ -1,5 +1,11 @@
 """The planning problem: :class:`Problem`, its checks (limits, feasibility of the start and
-goal) and its construction from a problem file."""
+goal) and its construction from a problem file.
+
+A problem's scene is a planar :class:`~gdnplan.scene.Scene` or a 3-D
+:class:`~gdnplan.arm3d.Scene3D`; everything the planner asks of it goes through
+:mod:`gdnplan.exact`. The planar-only parts are a ``goal_position`` (and its reach) and the
+first-joint sweep test; a 3-D goal is a joint vector.
+"""
 
 from __future__ import annotations
 
@@ -9,10 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arm3d.scene3d import Scene3D
 from ..assets import problem_file
 from ..ccd import proven_distance
-from ..distance import signed_distance
 from ..errors import InfeasibleProblemError, InputError, ProblemFileError
+from ..exact import closest_pair, exact_distance
 from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number
 from ..robot import first_outside
 from ..scene import Scene
@@ -27,10 +34,11 @@ class Problem:
     """A planning problem: move the robot of ``scene`` from ``start`` to a goal.
 
     Attributes:
-        scene: robot and obstacles.
+        scene: robot and obstacles, planar (:class:`~gdnplan.scene.Scene`) or 3-D
+            (:class:`~gdnplan.arm3d.Scene3D`).
         start: (dof,) start joint angles (rad).
         goal: (dof,) goal joint angles (rad), or None when ``goal_position`` is given.
-        goal_position: (2,) end-effector goal in the plane (m), or None.
+        goal_position: (2,) end-effector goal in the plane (m), or None (planar scenes only).
         waypoints: 3 ≤ T ≤ ``limits.MAX_WAYPOINTS`` (500), waypoints including start and goal.
         margin: required clearance (m): the NLP keeps d ≥ margin at its check points, and a
             successful plan is proven to keep d > ``certified_clearance`` (the margin unless
@@ -50,7 +58,7 @@ class Problem:
             margin between check points.
     """
 
-    scene: Scene
+    scene: Scene | Scene3D
     start: np.ndarray
     goal: np.ndarray | None = None
     goal_position: np.ndarray | None = None
@@ -70,6 +78,10 @@ class Problem:
         return self.margin if self.clearance is None else self.clearance
 
     def __post_init__(self) -> None:
+        if not isinstance(self.scene, (Scene, Scene3D)):
+            raise InputError(
+                f"scene: expected a planar Scene or a Scene3D, got {type(self.scene).__name__}"
+            )
         robot = self.scene.robot
         set_ = object.__setattr__
         set_(
@@ -87,6 +99,11 @@ class Problem:
             raise InputError("goal: give exactly one of q (joint angles) or position ([x, y])")
         if self.goal is not None:
             set_(self, "goal", _vector(self.goal, robot.dof, "goal.q"))
+        elif isinstance(self.scene, Scene3D):
+            raise InputError(
+                "goal.position: a 3-D problem's goal is a joint vector q (end-effector pose "
+                "goals come with the 3-D pose IK)"
+            )
         else:
             set_(self, "goal_position", _vector(self.goal_position, 2, "goal.position"))
         check_int(self.waypoints, "options.waypoints", 3, MAX_WAYPOINTS)
@@ -145,13 +162,13 @@ class Problem:
                     f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
                     f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
                 )
-            d = float(signed_distance(self.scene, q)[0])
+            d = float(exact_distance(self.scene, q)[0])
             if d <= self.margin or proven_distance(d) <= self.certified_clearance:
                 raise InfeasibleProblemError(
-                    f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m; "
-                    "move it away from the obstacles or lower options.margin"
+                    f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m between "
+                    f"{closest_pair(self.scene, q)}; move it away or lower options.margin"
                 )
-        if self.goal is not None:
+        if self.goal is not None and isinstance(self.scene, Scene):
             blocked = first_joint_barrier(self.scene, self.start[0], self.goal[0])
             if blocked is not None:
                 raise InfeasibleProblemError(

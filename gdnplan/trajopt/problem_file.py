@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arm3d.scene3d import Scene3D
+from ..arm3d.scene_file3d import scene3d_from_config
 from ..assets import problem_file
 from ..errors import InputError, ProblemFileError
 from ..limits import IPOPT_OPTIONS, is_number
@@ -32,6 +34,10 @@ TOP_KEYS = frozenset(
 )
 START_KEYS = frozenset({"q"})
 GOAL_KEYS = frozenset({"q", "position"})  # exactly one of them
+# a file with a [scene3d] table is a 3-D problem (docs/problem_file_3d.md): [robot] names a
+# 3-D robot, [scene3d] holds the obstacles, the goal is a joint vector
+TOP_KEYS_3D = frozenset({"robot", "scene3d", "start", "goal", "options", "solver", *PLAN_TABLES})
+GOAL_KEYS_3D = frozenset({"q"})
 OPTION_KEYS = frozenset(
     {"waypoints", "margin", "clearance", "max_step", "goal_tolerance", "lower", "upper"}
 )
@@ -64,7 +70,7 @@ class ProblemTables:
     """A problem file's tables, checked but not yet a Problem: the scene, the raw ``[start] q``
     and ``[goal]`` (None when absent), the ``[options]`` and the planner settings."""
 
-    scene: Scene
+    scene: Scene | Scene3D
     start: object
     goal: dict | None
     options: dict
@@ -74,9 +80,13 @@ class ProblemTables:
 def problem_tables(cfg: dict, base_dir=None, require_goal: bool = True) -> ProblemTables:
     """Check every table of a parsed problem file and build its scene and planner settings;
     ``require_goal``: a ``[start] q`` and a ``[goal]`` must be there (False: a scene-only file,
-    as ``gdnplan show`` draws). ProblemFileError names any bad field."""
-    _no_unknown(cfg, TOP_KEYS, "top level")
-    for key, keys in (("start", START_KEYS), ("goal", GOAL_KEYS)):
+    as ``gdnplan show`` draws). A file with a ``[scene3d]`` table is a 3-D problem
+    (:func:`gdnplan.arm3d.scene_file3d.scene3d_from_config`). ProblemFileError names any bad
+    field."""
+    three_d = "scene3d" in cfg
+    _no_unknown(cfg, TOP_KEYS_3D if three_d else TOP_KEYS, "top level")
+    goal_keys = GOAL_KEYS_3D if three_d else GOAL_KEYS
+    for key, keys in (("start", START_KEYS), ("goal", goal_keys)):
         if key not in cfg and not require_goal:
             continue
         if key not in cfg:
@@ -89,12 +99,17 @@ def problem_tables(cfg: dict, base_dir=None, require_goal: bool = True) -> Probl
         raise ProblemFileError("[options]: expected a table")
     _no_unknown(options, OPTION_KEYS, "[options]")
     solver = plan_config_from_tables(cfg)
-    try:
-        scene = scene_from_config(cfg, base_dir)
-    except TypeError as e:
-        raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
+    if three_d:
+        scene = scene3d_from_config(cfg, base_dir)
+    else:
+        try:
+            scene = scene_from_config(cfg, base_dir)
+        except TypeError as e:
+            raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
     goal = cfg.get("goal")
-    if goal is not None and ("q" in goal) == ("position" in goal):
+    if three_d and goal is not None and "q" not in goal:
+        raise ProblemFileError("[goal] q: missing; give the goal joint angles", schema=True)
+    if not three_d and goal is not None and ("q" in goal) == ("position" in goal):
         raise ProblemFileError(
             "[goal]: give exactly one of q = [...] or position = [x, y]", schema=True
         )
@@ -234,10 +249,12 @@ def _vector(value, n: int, name: str) -> np.ndarray:
 __all__ = [
     "CONFIG_KEYS",
     "GOAL_KEYS",
+    "GOAL_KEYS_3D",
     "OPTION_KEYS",
     "SOLVER_KEYS",
     "START_KEYS",
     "TOP_KEYS",
+    "TOP_KEYS_3D",
     "ProblemTables",
     "plan_config_from_tables",
     "problem_start",

@@ -9,8 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..ccd import Certificate, certify_path
+from ..ccd import Certificate
 from ..errors import InputError
+from ..exact import certify
 from ..timing import TimedTrajectory
 from .ik import tip_position
 from .problem import Problem
@@ -112,7 +113,7 @@ class _Run:
 def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
     """Certify the path with coal, check the goal, package the Plan."""
     clearance = problem.certified_clearance
-    cert = run.verified or certify_path(problem.scene, run.q, margin=clearance)
+    cert = run.verified or certify(problem.scene, run.q, margin=clearance)
     reached = _goal_error(problem, run.q[-1]) <= problem.goal_tolerance
     reason = run.reason
     if not cert.ok:

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..distance import signed_distance
 from ..errors import InputError
+from ..exact import exact_distance
 from ..rrt import resample, rrt_connect, seed_path, shortcut
 from .check_points import straight_line
 from .config import SEED_KINDS
@@ -98,7 +98,7 @@ def via_seed(request: SeedRequest) -> np.ndarray | None:
     p = request.problem
     rng = np.random.default_rng([request.stream, 1])  # not the stream of the rrt kind
     draws = rng.uniform(p.lower, p.upper, (VIA_DRAWS, p.scene.robot.dof))
-    free = np.flatnonzero(signed_distance(p.scene, draws) > request.clearance)
+    free = np.flatnonzero(exact_distance(p.scene, draws) > request.clearance)
     if free.size == 0:
         return None
     via = draws[free[0]]
