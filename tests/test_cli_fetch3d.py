@@ -1,0 +1,58 @@
+"""``gdnplan fetch --3d``: bad input is one error line with exit 2 and nothing written; the
+whole fetch (slow) prints every stage certified and writes a problem file per planned stage."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from gdnplan.arm3d.fetch3d import PLANNED, STAGES
+from gdnplan.arm3d.fetch3d_files import read_stage_problems
+
+BAD = [
+    ["fetch", "--3d", "--seed", "abc"],
+    ["fetch", "--3d", "--seed", "1.5"],
+    ["fetch", "--3d", "--seed", "-1"],
+    ["fetch", "--3d", "--placement", "0.7,0,3.14159"],  # the entrance faces away: out of reach
+    ["fetch", "--3d", "--placement", "0.7,0"],
+    ["fetch", "--3d", "--placement", "0.7,x,0"],
+    ["fetch", "--3d", "--placement", "1.0,0,0"],  # off the table
+    ["fetch", "--3d", "--placement", "nan,0,0"],
+    ["fetch", "--placement", "0.7,0,0"],  # planar fetch
+    ["fetch", "--write-problems", "{tmp}/out"],
+    ["fetch", "--3d", "--animate", "{tmp}/x.gif"],
+    ["fetch", "--3d", "--collision", "graphdistnet3d"],
+    ["fetch", "--3d", "--write-problems", "{tmp}/a_file"],
+]
+
+
+@pytest.mark.parametrize("args", BAD, ids=lambda a: " ".join(a[1:]))
+def test_bad_input_is_one_error_line_exit_2_and_writes_nothing(args, tmp_path, capsys):
+    from gdnplan.cli import run
+
+    (tmp_path / "a_file").write_text("x")
+    before = sorted(tmp_path.rglob("*"))
+    with pytest.raises(SystemExit) as exit_:
+        run([a.replace("{tmp}", str(tmp_path)) for a in args])
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert exit_.value.code == 2, err
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    assert sorted(tmp_path.rglob("*")) == before
+
+
+@pytest.mark.slow
+def test_the_canonical_3d_fetch_is_certified_and_writes_its_problems(tmp_path, capsys):
+    from gdnplan.cli import run
+
+    out = tmp_path / "problems"
+    with pytest.raises(SystemExit) as exit_:
+        run(["fetch", "--3d", "--json", "-q", "--write-problems", str(out)])
+    assert exit_.value.code in (0, None)
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["success"] and [s["stage"] for s in summary["stages"]] == list(STAGES)
+    assert all(s["success"] for s in summary["stages"])
+    assert sorted(p.name for p in out.iterdir()) == sorted(f"fetch3d_{s}.toml" for s in PLANNED)
+    for path in out.iterdir():
+        assert read_stage_problems(path)
