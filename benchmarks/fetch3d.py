@@ -16,7 +16,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from common import Report, parse, parser
+import common
 
 from gdnplan.arm3d import certify_path3d
 from gdnplan.arm3d.fetch3d import MARGIN, STAGES, run_fetch3d
@@ -32,10 +32,10 @@ def seeds_arg(text: str) -> list[int]:
 
 
 def main() -> None:
-    p = parser("fetch3d", __doc__)
+    p = common.parser("fetch3d", __doc__)
     p.add_argument("--seeds", type=seeds_arg, default=list(range(1, 9)), help="fetch seeds")
-    args = parse(p)
-    report = Report(args, "3-D fetch: 8 random storage placements", __doc__.split("\n\n")[1])
+    args = common.parse(p)
+    report = common.Report(args, "3-D fetch: 8 random storage placements", __doc__.split("\n\n")[1])
     rows = report.table(
         "seed",
         "placement x, y (m), yaw (rad)",
