@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
 import common
+import numpy as np
 
 from gdnplan.arm3d import certify_path3d
 from gdnplan.arm3d.fetch3d import MARGIN, STAGES, run_fetch3d
