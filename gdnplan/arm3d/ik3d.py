@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from ..errors import InfeasibleProblemError, InputError
 from ..limits import check_int, check_number
@@ -134,9 +135,9 @@ def nearest_equivalent(robot: Robot3D, q: np.ndarray, reference: np.ndarray) -> 
 
 def solve_pose_ik(
     scene: Scene3D | Robot3D,
-    position,
-    rotation=None,
-    reference=None,
+    position: ArrayLike,
+    rotation: ArrayLike | None = None,
+    reference: ArrayLike | None = None,
     frame: str | None = None,
     margin: float = 0.0,
     restarts: int = 64,
