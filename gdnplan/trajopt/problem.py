@@ -29,7 +29,6 @@ from .ik import first_joint_barrier, tip_reach
 from .options import TrajoptOptions
 from .problem_file import ProblemTables, _vector, problem_tables, read_problem_file
 
-
 POSE_GOAL_SPARE = 1e-3  # m: a pose goal's IK keeps the margin plus this (coal's slack)
 
 
