@@ -47,6 +47,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.builtin",
             "arm3d.scene3d",
             "arm3d.storage3d",  # the 3-D fetch storage: boxes and tool poses, no distances
+            "arm3d.fk3d",  # batched forward kinematics in numpy
         ),
     ),
     (
@@ -66,6 +67,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.ik3d",
             "arm3d.held",
             "arm3d.fetch3d_scene",
+            "arm3d.scene_file3d",  # 3-D problem-file tables -> Scene3D (pose goals by IK)
+            "exact",  # the exact-geometry protocol of planar and 3-D scenes
             "path_metrics",
             "ompl_planner",
         ),
@@ -73,7 +76,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("graphs", ("graph",)),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
-    ("trajopt", ("trajopt", "trajopt.*", "timing")),
+    ("trajopt", ("trajopt", "trajopt.*", "timing", "arm3d.problem3d")),
     ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
     (
         "paper reproduction",

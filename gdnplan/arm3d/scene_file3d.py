@@ -14,10 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import GdnplanError, ProblemFileError
+from ..errors import GdnplanError, InputError, ProblemFileError
 from ..limits import is_number
 from ..scene import no_unknown_keys
 from .builtin import load_robot3d
+from .ik3d import solve_pose_ik
 from .robot3d import Robot3D, robot3d_from_urdf
 from .scene3d import (
     Obstacle3D,
@@ -36,6 +37,7 @@ ROBOT3D_KEYS = frozenset({"name", "urdf", "srdf", "package_dirs", "joints", "loc
 SCENE3D_KEYS = frozenset({"random_boxes", "obstacles"})
 RANDOM_BOXES_KEYS = frozenset({"n", "seed", "size", "base_clearance"})
 ROTATION_KEYS = ("quaternion", "rpy", "matrix")
+POSE_GOAL_KEYS = frozenset({"position", "frame", *ROTATION_KEYS})
 POSE_KEYS = frozenset({"type", "name", "position", *ROTATION_KEYS})
 OBSTACLE3D_KEYS = {  # type -> its own keys besides POSE_KEYS
     "box": frozenset({"size"}),
@@ -166,6 +168,30 @@ def obstacle_from_table(table, k: int, base_dir: Path) -> Obstacle3D:
         raise ProblemFileError(f"{where} ({name}): {e}") from e
 
 
+def pose_goal(scene: Scene3D, table, reference, margin: float) -> np.ndarray:
+    """The joint goal (dof,) of ``[goal] pose = {position = [x, y, z], quaternion | rpy |
+    matrix = …, frame = "…"}``: the tool frame's pose IK
+    (:func:`gdnplan.arm3d.ik3d.solve_pose_ik`) clear of ``margin`` (m), nearest ``reference``
+    (the start). InfeasibleProblemError when no collision-free IK solution exists."""
+    where = "[goal] pose"
+    if not isinstance(table, dict):
+        raise ProblemFileError(f"{where}: expected a table {{position = [x, y, z], rpy = [...]}}")
+    no_unknown_keys(table, POSE_GOAL_KEYS, where)
+    if "position" not in table:
+        raise ProblemFileError(f"{where} position: missing; give the tool position [x, y, z] (m)")
+    frame = table.get("frame")
+    if frame is not None and not isinstance(frame, str):
+        raise ProblemFileError(f"{where} frame: expected a frame name, got {frame!r}")
+    rotation = rotation_of(table, where)
+    try:
+        solved = solve_pose_ik(scene, table["position"], rotation, reference, frame, margin)
+    except ProblemFileError:
+        raise
+    except InputError as e:
+        raise ProblemFileError(f"{where}: {e}") from e
+    return solved.q
+
+
 def scene3d_from_config(cfg: dict, base_dir=None) -> Scene3D:
     """The :class:`Scene3D` of a parsed 3-D problem file (``[robot]`` and ``[scene3d]``);
     random boxes first (named box0 …), then the listed obstacles."""
@@ -217,10 +243,12 @@ def _random_boxes(spec, robot: Robot3D) -> list[Obstacle3D]:
 
 __all__ = [
     "OBSTACLE3D_KEYS",
+    "POSE_GOAL_KEYS",
     "POSE_KEYS",
     "RANDOM_BOXES_KEYS",
     "ROBOT3D_KEYS",
     "SCENE3D_KEYS",
+    "pose_goal",
     "rpy_matrix",
     "scene3d_from_config",
 ]

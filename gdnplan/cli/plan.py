@@ -43,6 +43,8 @@ def show(
 
     check_output_path(out, FIGURE_SUFFIXES, "--out")
     scene, start = scene_and_start(target, seed)
+    if is_3d(scene):
+        raise InputError(f"show: {target} is a 3-D problem; draw it with gdnplan plan --view3d")
     if q is not None:
         config = check_limits(
             scene.robot, scene.robot.check_q(parse_vector(q, "--q"), "--q")[0], "--q"
@@ -57,7 +59,11 @@ def show(
 @app.command("plan")
 def plan_command(
     problem_file: str = typer.Argument(..., help=PROBLEM_HELP),
-    collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
+    collision: str = typer.Option(
+        None,
+        help="Collision model: graphdistnet or coal; default: graphdistnet for a planar "
+        "problem, coal for a 3-D one (no learned 3-D model ships yet).",
+    ),
     solver: str = typer.Option(
         None,
         help="ipopt (direct transcription) or adam (paper); default: the problem file's "
@@ -98,6 +104,10 @@ def plan_command(
 
         require_meshcat()
     problem = Problem.from_toml(problem_file)
+    if collision is None:
+        collision = "coal" if is_3d(problem.scene) else "graphdistnet"
+    if animate is not None and is_3d(problem.scene):
+        raise InputError("--animate: planar problems only; view a 3-D plan with --view3d")
     config = plan_flags_config(problem, solver, seeds, time_budget)
     result = plan(
         problem,
@@ -131,6 +141,13 @@ def plan_command(
         view_plan([(problem.scene, result.q)])
     if not result.success:
         raise typer.Exit(1)
+
+
+def is_3d(scene) -> bool:
+    """True for a 3-D scene (:class:`gdnplan.arm3d.Scene3D`)."""
+    from ..arm3d.scene3d import Scene3D
+
+    return isinstance(scene, Scene3D)
 
 
 def plan_flags_config(problem, solver: str | None, seeds: int | None, time_budget: float | None):

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..arm3d.scene3d import Scene3D
+from ..arm3d.scene_file3d import pose_goal
 from ..assets import problem_file
 from ..ccd import proven_distance
 from ..errors import InfeasibleProblemError, InputError, ProblemFileError
@@ -27,6 +28,8 @@ from .config import PlanConfig
 from .ik import first_joint_barrier, tip_reach
 from .options import TrajoptOptions
 from .problem_file import ProblemTables, _vector, problem_tables, read_problem_file
+
+POSE_GOAL_SPARE = 1e-3  # m: a pose goal's IK keeps the margin plus this (coal's slack)
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,8 +207,13 @@ class Problem:
     def from_tables(cls, tables: ProblemTables) -> Problem:
         """Problem from a file's checked tables
         (:func:`~gdnplan.trajopt.problem_file.problem_tables`)."""
-        goal = tables.goal or {}
+        goal = dict(tables.goal or {})
         try:
+            if "pose" in goal:  # a 3-D tool pose: its IK nearest the start, clear of the margin
+                start = _vector(tables.start, tables.scene.robot.dof, "start.q")
+                margin = tables.options.get("margin", cls.margin)
+                margin = check_number(margin, "options.margin") + POSE_GOAL_SPARE
+                goal["q"] = pose_goal(tables.scene, goal.pop("pose"), start, margin)
             return cls(
                 scene=tables.scene,
                 start=tables.start,

@@ -37,7 +37,7 @@ GOAL_KEYS = frozenset({"q", "position"})  # exactly one of them
 # a file with a [scene3d] table is a 3-D problem (docs/problem_file_3d.md): [robot] names a
 # 3-D robot, [scene3d] holds the obstacles, the goal is a joint vector
 TOP_KEYS_3D = frozenset({"robot", "scene3d", "start", "goal", "options", "solver", *PLAN_TABLES})
-GOAL_KEYS_3D = frozenset({"q"})
+GOAL_KEYS_3D = frozenset({"q", "pose"})  # exactly one of them
 OPTION_KEYS = frozenset(
     {"waypoints", "margin", "clearance", "max_step", "goal_tolerance", "lower", "upper"}
 )
@@ -107,8 +107,11 @@ def problem_tables(cfg: dict, base_dir=None, require_goal: bool = True) -> Probl
         except TypeError as e:
             raise ProblemFileError(f"[robot]/[scene]: unsupported option ({e})") from e
     goal = cfg.get("goal")
-    if three_d and goal is not None and "q" not in goal:
-        raise ProblemFileError("[goal] q: missing; give the goal joint angles", schema=True)
+    if three_d and goal is not None and ("q" in goal) == ("pose" in goal):
+        raise ProblemFileError(
+            "[goal]: give exactly one of q = [...] or pose = {position = [x, y, z], ...}",
+            schema=True,
+        )
     if not three_d and goal is not None and ("q" in goal) == ("position" in goal):
         raise ProblemFileError(
             "[goal]: give exactly one of q = [...] or position = [x, y]", schema=True
