@@ -137,7 +137,7 @@ def obstacle_from_table(table, k: int, base_dir: Path) -> Obstacle3D:
     if not isinstance(table, dict):
         raise ProblemFileError(f"{where}: expected a table with type = ...")
     kind = table.get("type")
-    if kind not in OBSTACLE3D_KEYS:
+    if not isinstance(kind, str) or kind not in OBSTACLE3D_KEYS:
         raise ProblemFileError(
             f"{where} type: expected one of {list(OBSTACLE3D_KEYS)}, got {kind!r}"
         )
