@@ -85,7 +85,9 @@ def test_a_mesh_file_relative_to_the_problem(tmp_path):
         "".join(f"v {x} {y} {z}\n" for x, y, z in corners)
         + "".join("f " + " ".join(map(str, f)) + "\n" for f in faces)
     )
-    scene = scene3d_from_config(small(type="mesh", file="cube.obj", position=[0.6, 0, 0.3]), tmp_path)
+    scene = scene3d_from_config(
+        small(type="mesh", file="cube.obj", position=[0.6, 0, 0.3]), tmp_path
+    )
     assert len(scene.obstacles) == 1
 
 
@@ -99,18 +101,34 @@ def test_random_boxes_and_listed_obstacles_add_up():
     "change, message",
     [
         (lambda c: c["robot"].update(name="r2d2"), "unknown 3-D robot 'r2d2'"),
-        (lambda c: c["scene3d"].update(obstacles=[{"type": "mesh", "file": "nope.stl"}]),
-         "nope.stl does not exist"),
-        (lambda c: c["scene3d"]["obstacles"][0].update(matrix=[[1, 0, 0], [0, 1, 0], [0, 0, -1]]),
-         "not a rotation matrix"),
+        (
+            lambda c: c["scene3d"].update(obstacles=[{"type": "mesh", "file": "nope.stl"}]),
+            "nope.stl does not exist",
+        ),
+        (
+            lambda c: c["scene3d"]["obstacles"][0].update(
+                matrix=[[1, 0, 0], [0, 1, 0], [0, 0, -1]]
+            ),
+            "not a rotation matrix",
+        ),
         (lambda c: c["scene3d"]["obstacles"][0].update(quaternion=[0, 0, 0, 0]), "zero length"),
-        (lambda c: c["scene3d"]["obstacles"][0].update(rpy=[0, 0], ), "rpy"),
-        (lambda c: c["scene3d"]["obstacles"][0].update(rpy=[0, 0, 0], quaternion=[0, 0, 0, 1]),
-         "at most one of"),
+        (
+            lambda c: c["scene3d"]["obstacles"][0].update(
+                rpy=[0, 0],
+            ),
+            "rpy",
+        ),
+        (
+            lambda c: c["scene3d"]["obstacles"][0].update(rpy=[0, 0, 0], quaternion=[0, 0, 0, 1]),
+            "at most one of",
+        ),
         (lambda c: c["scene3d"]["obstacles"][0].update(type="cone"), "type: expected one of"),
         (lambda c: c["scene3d"]["obstacles"][0].pop("size"), "size: missing"),
         (lambda c: c["scene3d"].update(colour="red"), "colour"),
-        (lambda c: c["goal"].update(q=[0.4, -1.57, 1.0, -1.0, 0.0, 9.0]), r"goal.q\[5\] = 9 is outside the joint limits"),
+        (
+            lambda c: c["goal"].update(q=[0.4, -1.57, 1.0, -1.0, 0.0, 9.0]),
+            r"goal.q\[5\] = 9 is outside the joint limits",
+        ),
         (lambda c: c["goal"].update(position=[0.1, 0.2]), r"\[goal\]: unknown key.*position"),
         (lambda c: c["scene3d"].update(random_boxes={"n": -1}), "random_boxes n"),
     ],

@@ -77,9 +77,7 @@ def test_adam_and_acceleration_limits_run_on_a_3d_scene():
     result = plan(problem, collision="coal", solver=AdamConfig(iterations=30))
     if result.success:  # 30 iterations may not suffice; success must then be proven
         assert certify_path3d(problem.scene, result.q, problem.margin).ok
-    free = Problem(
-        Scene3D(load_robot3d("ur5e"), []), START, goal=GOAL, waypoints=5, margin=0.02
-    )
+    free = Problem(Scene3D(load_robot3d("ur5e"), []), START, goal=GOAL, waypoints=5, margin=0.02)
     timed = plan(free, collision="coal", max_acceleration=2.0)
     assert timed.success and timed.attempts == 0  # the straight line, certified
     assert timed.trajectory.kind == "stop"  # the curve certificate is planar
