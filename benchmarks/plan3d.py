@@ -32,14 +32,14 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import numpy as np  # noqa: E402
-from common import Report, first_paragraph, parse, parser  # noqa: E402
+import numpy as np
+from common import Report, first_paragraph, parse, parser
 
-import gdnplan as gp  # noqa: E402
-from gdnplan.arm3d.problem3d import BOX_SIZES, collision_fraction, reaching_problems  # noqa: E402
-from gdnplan.exact import certify  # noqa: E402
-from gdnplan.ompl_planner import plan_ompl  # noqa: E402
-from gdnplan.path_metrics import resampled_cost  # noqa: E402
+import gdnplan as gp
+from gdnplan.arm3d.problem3d import BOX_SIZES, collision_fraction, reaching_problems
+from gdnplan.exact import certify
+from gdnplan.ompl_planner import plan_ompl
+from gdnplan.path_metrics import resampled_cost
 
 
 def run_gdnplan(problem) -> dict:

@@ -201,7 +201,7 @@ FIELDS = ["type", "size", "radius", "length", "points", "file", "position", "qua
 @pytest.mark.slow  # ~15 s: every example builds a UR5e problem
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    field=st.sampled_from(FIELDS + ["robot", "random_boxes", "start", "goal"]),
+    field=st.sampled_from([*FIELDS, "robot", "random_boxes", "start", "goal"]),
     value=values,
 )
 def test_fuzzed_3d_tables_raise_only_problem_errors(field, value):

@@ -9,8 +9,8 @@ import pytest
 
 import gdnplan as gp
 from gdnplan.assets import problem_names
-from gdnplan.exact import certify
 from gdnplan.cli import plan_summary
+from gdnplan.exact import certify
 from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
 from gdnplan.trajopt.check_points import constraint_margin
 from gdnplan.trajopt.result import _finish, _Run

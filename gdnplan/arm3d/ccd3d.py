@@ -1,4 +1,4 @@
-"""Continuous collision certificate of 3-D joint paths (conservative advancement).
+r"""Continuous collision certificate of 3-D joint paths (conservative advancement).
 
 Along the straight joint-space piece q(s) = q_a + s (q_b − q_a), s ∈ [0, 1], a point p of robot
 shape σ (on body b) moves with ṗ = Σ_j ω_j × (p − o_j) Δq_j over the planning joints j that
