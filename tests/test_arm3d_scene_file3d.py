@@ -12,7 +12,7 @@ import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from gdnplan.arm3d import Scene3D, signed_distance3d
+from gdnplan.arm3d import Scene3D, load_robot3d, signed_distance3d
 from gdnplan.arm3d.scene_file3d import rpy_matrix, scene3d_from_config
 from gdnplan.errors import GdnplanError, InfeasibleProblemError, ProblemFileError
 from gdnplan.trajopt import Problem, read_problem_file
@@ -218,3 +218,29 @@ def test_fuzzed_3d_tables_raise_only_problem_errors(field, value):
         Problem.from_config(cfg)
     except GdnplanError as e:
         assert "\n" not in str(e)
+
+
+def test_a_user_urdf_with_its_srdf(tmp_path):
+    """[robot] urdf (+ srdf, joints, locked), paths relative to the problem file."""
+    import shutil
+
+    from gdnplan.assets import robot_urdf
+
+    for suffix in (".urdf", ".srdf"):
+        shutil.copy(robot_urdf("ur5e").with_suffix(suffix), tmp_path / f"arm{suffix}")
+    cfg = small()
+    cfg["robot"] = {
+        "urdf": "arm.urdf",
+        "srdf": "arm.srdf",
+        "joints": list(load_robot3d("ur5e").joint_names),
+        "locked": {"left_finger_joint": 0.02, "right_finger_joint": 0.02},
+    }
+    problem = Problem.from_config(cfg, tmp_path)
+    builtin = load_robot3d("ur5e")
+    assert problem.scene.robot.dof == 6
+    assert len(problem.scene.robot.self_pairs) == len(builtin.self_pairs)
+    q = np.array(cfg["start"]["q"])
+    np.testing.assert_allclose(
+        signed_distance3d(problem.scene, q),
+        signed_distance3d(Scene3D(builtin, problem.scene.obstacles), q),
+    )
