@@ -7,7 +7,7 @@ from gdnplan.arm3d import Scene3D, box_obstacle, certify_path3d, load_robot3d
 
 pytest.importorskip("ompl")
 
-from gdnplan.ompl_planner import plan_ompl  # noqa: E402
+from gdnplan.ompl_planner import plan_ompl
 
 START = np.array([-0.6, -1.2, 1.2, -1.5, -1.57, 0.0])
 GOAL = np.array([0.6, -1.2, 1.2, -1.5, -1.57, 0.0])
