@@ -1,10 +1,10 @@
 """Planning in 3-D: gdnplan (coal + Ipopt) beside OMPL RRT-Connect on random reaching problems.
 
 Usage: python benchmarks/plan3d.py --threads 1 [--robots ur5e panda] [--problems 20]
-       [--ompl-time 10] [--out benchmarks/results/plan3d.md]
+       [--rrt-time 5] [--ompl-time 10] [--out benchmarks/results/plan3d.md]
 
 Problems: :func:`gdnplan.arm3d.problem3d.reaching_problems` (seed 0): for each robot, problem
-i is the robot among 20 random boxes (scene seed i, box sides from ``BOX_SIZES``), a start and
+i is the robot among 20 random boxes (scene seed i, box sides and base clearance from ``BOXES``), a start and
 a goal clear of the margin (0.02 m) within the joint box (the limits cut to ±π), and a straight
 joint-space line that collides. The share of uniformly random configurations in collision is
 measured on the same scenes (the 3-D counterpart of environment (d)'s 25–40 %).
@@ -12,7 +12,8 @@ measured on the same scenes (the 3-D counterpart of environment (d)'s 25–40 %)
 Methods, on every problem in one run:
 
 - gdnplan: ``gp.plan(problem, collision="coal")`` with its defaults (Ipopt, RRT-Connect seeds,
-  the 3-D conservative-advancement certificate at the margin, self-collision included);
+  the 3-D conservative-advancement certificate at the margin, self-collision included) except
+  ``SeedConfig.rrt_time = --rrt-time`` (s, wall time of one RRT-Connect run; the default 5);
 - OMPL RRT-Connect + its path simplifier (:func:`gdnplan.ompl_planner.plan_ompl`), planning
   time limit ``--ompl-time`` s, on the same validity rule (proven state distance > margin,
   motions accepted by the same edge certificate).
@@ -32,19 +33,20 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import numpy as np  # noqa: E402
-from common import Report, first_paragraph, parse, parser  # noqa: E402
+import numpy as np
+from common import Report, first_paragraph, parse, parser
 
-import gdnplan as gp  # noqa: E402
-from gdnplan.arm3d.problem3d import BOX_SIZES, collision_fraction, reaching_problems  # noqa: E402
-from gdnplan.exact import certify  # noqa: E402
-from gdnplan.ompl_planner import plan_ompl  # noqa: E402
-from gdnplan.path_metrics import resampled_cost  # noqa: E402
+import gdnplan as gp
+from gdnplan.arm3d.problem3d import BOXES, collision_fraction, reaching_problems
+from gdnplan.exact import certify
+from gdnplan.ompl_planner import plan_ompl
+from gdnplan.path_metrics import resampled_cost
 
 
-def run_gdnplan(problem) -> dict:
+def run_gdnplan(problem, rrt_time: float) -> dict:
     t0 = time.perf_counter()
-    result = gp.plan(problem, collision="coal")
+    config = gp.PlanConfig(seed=gp.SeedConfig(rrt_time=rrt_time))
+    result = gp.plan(problem, collision="coal", solver=config)
     elapsed = time.perf_counter() - t0
     cert = certify(problem.scene, result.q, problem.certified_clearance)
     ok = bool(result.success and cert.ok)
@@ -96,6 +98,7 @@ def main(argv=None) -> None:
     p = parser("plan3d", first_paragraph(__doc__))
     p.add_argument("--robots", nargs="+", default=["ur5e", "panda"])
     p.add_argument("--problems", type=int, default=20)
+    p.add_argument("--rrt-time", type=float, default=5.0, help="gdnplan's RRT-Connect limit (s)")
     p.add_argument("--ompl-time", type=float, default=10.0, help="OMPL planning time limit (s)")
     args = parse(p, argv)
     report = Report(args, "Planning in 3-D: gdnplan (coal + Ipopt) and OMPL RRT-Connect", __doc__)
@@ -108,7 +111,7 @@ def main(argv=None) -> None:
         shares = [collision_fraction(p.scene, 200, seed=i) for i, p in enumerate(problems)]
         share = (
             f"{100 * np.mean(shares):.0f} % ({100 * min(shares):.0f}–{100 * max(shares):.0f} %, "
-            f"boxes {BOX_SIZES[name][0]}–{BOX_SIZES[name][1]} m)"
+            f"boxes {BOXES[name][0][0]}–{BOXES[name][0][1]} m, ≥ {BOXES[name][1]} m from the base)"
         )
         detail = report.table(
             "robot", "problem", "gdnplan ok", "time (s)", "cost", "clearance (m)",
@@ -116,7 +119,7 @@ def main(argv=None) -> None:
         )  # fmt: skip
         rows = {"gdnplan": [], "OMPL RRT-Connect": []}
         for i, problem in enumerate(problems):
-            g = run_gdnplan(problem)
+            g = run_gdnplan(problem, args.rrt_time)
             o = run_ompl(problem, args.ompl_time, seed=i)
             rows["gdnplan"].append(g)
             rows["OMPL RRT-Connect"].append(o)

@@ -12,7 +12,7 @@ import tomli_w
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from gdnplan.arm3d import Scene3D, signed_distance3d
+from gdnplan.arm3d import Scene3D, load_robot3d, signed_distance3d
 from gdnplan.arm3d.scene_file3d import rpy_matrix, scene3d_from_config
 from gdnplan.errors import GdnplanError, InfeasibleProblemError, ProblemFileError
 from gdnplan.trajopt import Problem, read_problem_file
@@ -85,7 +85,9 @@ def test_a_mesh_file_relative_to_the_problem(tmp_path):
         "".join(f"v {x} {y} {z}\n" for x, y, z in corners)
         + "".join("f " + " ".join(map(str, f)) + "\n" for f in faces)
     )
-    scene = scene3d_from_config(small(type="mesh", file="cube.obj", position=[0.6, 0, 0.3]), tmp_path)
+    scene = scene3d_from_config(
+        small(type="mesh", file="cube.obj", position=[0.6, 0, 0.3]), tmp_path
+    )
     assert len(scene.obstacles) == 1
 
 
@@ -99,18 +101,34 @@ def test_random_boxes_and_listed_obstacles_add_up():
     "change, message",
     [
         (lambda c: c["robot"].update(name="r2d2"), "unknown 3-D robot 'r2d2'"),
-        (lambda c: c["scene3d"].update(obstacles=[{"type": "mesh", "file": "nope.stl"}]),
-         "nope.stl does not exist"),
-        (lambda c: c["scene3d"]["obstacles"][0].update(matrix=[[1, 0, 0], [0, 1, 0], [0, 0, -1]]),
-         "not a rotation matrix"),
+        (
+            lambda c: c["scene3d"].update(obstacles=[{"type": "mesh", "file": "nope.stl"}]),
+            "nope.stl does not exist",
+        ),
+        (
+            lambda c: c["scene3d"]["obstacles"][0].update(
+                matrix=[[1, 0, 0], [0, 1, 0], [0, 0, -1]]
+            ),
+            "not a rotation matrix",
+        ),
         (lambda c: c["scene3d"]["obstacles"][0].update(quaternion=[0, 0, 0, 0]), "zero length"),
-        (lambda c: c["scene3d"]["obstacles"][0].update(rpy=[0, 0], ), "rpy"),
-        (lambda c: c["scene3d"]["obstacles"][0].update(rpy=[0, 0, 0], quaternion=[0, 0, 0, 1]),
-         "at most one of"),
+        (
+            lambda c: c["scene3d"]["obstacles"][0].update(
+                rpy=[0, 0],
+            ),
+            "rpy",
+        ),
+        (
+            lambda c: c["scene3d"]["obstacles"][0].update(rpy=[0, 0, 0], quaternion=[0, 0, 0, 1]),
+            "at most one of",
+        ),
         (lambda c: c["scene3d"]["obstacles"][0].update(type="cone"), "type: expected one of"),
         (lambda c: c["scene3d"]["obstacles"][0].pop("size"), "size: missing"),
         (lambda c: c["scene3d"].update(colour="red"), "colour"),
-        (lambda c: c["goal"].update(q=[0.4, -1.57, 1.0, -1.0, 0.0, 9.0]), r"goal.q\[5\] = 9 is outside the joint limits"),
+        (
+            lambda c: c["goal"].update(q=[0.4, -1.57, 1.0, -1.0, 0.0, 9.0]),
+            r"goal.q\[5\] = 9 is outside the joint limits",
+        ),
         (lambda c: c["goal"].update(position=[0.1, 0.2]), r"\[goal\]: unknown key.*position"),
         (lambda c: c["scene3d"].update(random_boxes={"n": -1}), "random_boxes n"),
     ],
@@ -183,7 +201,7 @@ FIELDS = ["type", "size", "radius", "length", "points", "file", "position", "qua
 @pytest.mark.slow  # ~15 s: every example builds a UR5e problem
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
-    field=st.sampled_from(FIELDS + ["robot", "random_boxes", "start", "goal"]),
+    field=st.sampled_from([*FIELDS, "robot", "random_boxes", "start", "goal"]),
     value=values,
 )
 def test_fuzzed_3d_tables_raise_only_problem_errors(field, value):
@@ -200,3 +218,29 @@ def test_fuzzed_3d_tables_raise_only_problem_errors(field, value):
         Problem.from_config(cfg)
     except GdnplanError as e:
         assert "\n" not in str(e)
+
+
+def test_a_user_urdf_with_its_srdf(tmp_path):
+    """[robot] urdf (+ srdf, joints, locked), paths relative to the problem file."""
+    import shutil
+
+    from gdnplan.assets import robot_urdf
+
+    for suffix in (".urdf", ".srdf"):
+        shutil.copy(robot_urdf("ur5e").with_suffix(suffix), tmp_path / f"arm{suffix}")
+    cfg = small()
+    cfg["robot"] = {
+        "urdf": "arm.urdf",
+        "srdf": "arm.srdf",
+        "joints": list(load_robot3d("ur5e").joint_names),
+        "locked": {"left_finger_joint": 0.02, "right_finger_joint": 0.02},
+    }
+    problem = Problem.from_config(cfg, tmp_path)
+    builtin = load_robot3d("ur5e")
+    assert problem.scene.robot.dof == 6
+    assert len(problem.scene.robot.self_pairs) == len(builtin.self_pairs)
+    q = np.array(cfg["start"]["q"])
+    np.testing.assert_allclose(
+        signed_distance3d(problem.scene, q),
+        signed_distance3d(Scene3D(builtin, problem.scene.obstacles), q),
+    )

@@ -9,20 +9,21 @@ import pytest
 
 import gdnplan as gp
 from gdnplan.assets import problem_names
-from gdnplan.ccd import certify_path
 from gdnplan.cli import plan_summary
+from gdnplan.exact import certify
 from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
 from gdnplan.trajopt.check_points import constraint_margin
 from gdnplan.trajopt.result import _finish, _Run
 
-SLOW = {"fetch_bring_out"}  # ~7 s with coal, over a minute with GraphDistNet
+SLOW = {"fetch_bring_out", "ur5e_boxes3d", "panda_shelf3d"}  # ~7-10 s with coal
+PROBLEMS_3D = {"ur5e_boxes3d", "panda_shelf3d"}  # coal only: no learned 3-D model ships
 
 
 def _check_kept(problem: Problem, result) -> None:
     assert result.success, result.reason
     assert result.clearance == problem.certified_clearance == problem.margin
     assert result.min_distance > problem.margin  # the proven bound, not bound − margin
-    cert = certify_path(problem.scene, result.q, problem.margin)
+    cert = certify(problem.scene, result.q, problem.margin)
     assert cert.ok and cert.lower_bound > problem.margin
 
 
@@ -40,6 +41,7 @@ def test_every_shipped_problem_keeps_its_margin_with_coal(name):
     [
         n if n == "planar2_square" else pytest.param(n, marks=pytest.mark.slow)
         for n in problem_names()
+        if n not in PROBLEMS_3D
     ],
 )
 def test_every_shipped_problem_keeps_its_margin_with_graphdistnet(name):
@@ -95,6 +97,6 @@ def test_without_a_buffer_the_refine_rounds_still_never_accept_less_than_the_mar
     assert not result.success or result.min_distance > problem.margin
     if not result.success:
         assert "clearance > 0.02 m failed" in result.reason
-    cert = certify_path(problem.scene, result.q, problem.margin)
+    cert = certify(problem.scene, result.q, problem.margin)
     assert cert.ok == result.success
     assert np.all(result.q[[0, -1]] == [problem.start, problem.goal])

@@ -44,7 +44,10 @@ def test_a_3d_plan_is_certified_along_the_whole_path():
     cert = certify_path3d(problem.scene, result.q, problem.margin)  # independent re-check
     assert cert.ok
     dense = np.concatenate(
-        [a + np.linspace(0, 1, 30)[:, None] * (b - a) for a, b in zip(result.q[:-1], result.q[1:])]
+        [
+            a + np.linspace(0, 1, 30)[:, None] * (b - a)
+            for a, b in zip(result.q[:-1], result.q[1:], strict=True)
+        ]
     )
     assert np.min(signed_distance3d(problem.scene, dense)) > problem.margin
     assert result.trajectory is not None and result.trajectory.kind == "linear"
@@ -77,9 +80,7 @@ def test_adam_and_acceleration_limits_run_on_a_3d_scene():
     result = plan(problem, collision="coal", solver=AdamConfig(iterations=30))
     if result.success:  # 30 iterations may not suffice; success must then be proven
         assert certify_path3d(problem.scene, result.q, problem.margin).ok
-    free = Problem(
-        Scene3D(load_robot3d("ur5e"), []), START, goal=GOAL, waypoints=5, margin=0.02
-    )
+    free = Problem(Scene3D(load_robot3d("ur5e"), []), START, goal=GOAL, waypoints=5, margin=0.02)
     timed = plan(free, collision="coal", max_acceleration=2.0)
     assert timed.success and timed.attempts == 0  # the straight line, certified
     assert timed.trajectory.kind == "stop"  # the curve certificate is planar
@@ -93,5 +94,5 @@ def test_coal_is_the_3d_model_and_no_learned_3d_model_ships():
 
 
 def test_a_3d_goal_is_a_joint_vector():
-    with pytest.raises(InputError, match="goal.position: a 3-D problem's goal is a joint vector"):
+    with pytest.raises(InputError, match=r"goal\.position: a 3-D problem's goal is a joint vector"):
         Problem(wall(), START, goal_position=np.array([0.3, 0.2]))

@@ -1,4 +1,4 @@
-"""Continuous collision certificate of 3-D joint paths (conservative advancement).
+r"""Continuous collision certificate of 3-D joint paths (conservative advancement).
 
 Along the straight joint-space piece q(s) = q_a + s (q_b − q_a), s ∈ [0, 1], a point p of robot
 shape σ (on body b) moves with ṗ = Σ_j ω_j × (p − o_j) Δq_j over the planning joints j that
@@ -10,8 +10,15 @@ the lever arms r_{σ,j} ≥ |p − o_j|, rigid bounds valid at every configurati
 with t_i the fixed translation of joint i in its parent's frame (the distance between
 consecutive joint origins), c_σ the shape's bounding-sphere centre in body b's joint frame and
 ρ_σ its radius; r_{σ,j} = 0 for joints that do not move shape σ. So no point of σ travels farther
-than δ_σ = Σ_j r_{σ,j} |Δq_j| along the piece, and the distance of any pair changes by at most
-Δ = max(max_σ δ_σ, max_{(σ,τ) self pairs} δ_σ + δ_τ). As in :mod:`gdnplan.ccd`, with proven
+than δ_σ = Σ_j r_{σ,j} |Δq_j| along the piece. A self pair's distance depends only on the
+relative pose of its two shapes, which joints supporting both do not change (they move both
+rigidly), so it changes by at most
+
+    δ_στ = Σ_{j ∈ S_σ \ S_τ} r_{σ,j} |Δq_j| + Σ_{j ∈ S_τ \ S_σ} r_{τ,j} |Δq_j|   ≤ δ_σ + δ_τ,
+
+S_σ the joints supporting σ's body (on a chain one shape's joints contain the other's, and
+δ_στ ≤ max(δ_σ, δ_τ)). The distance of any pair changes by at most
+Δ = max(max_σ δ_σ, max_{(σ,τ) self pairs} δ_στ). As in :mod:`gdnplan.ccd`, with proven
 lower bounds d̲_a, d̲_b at the ends (coal's estimate minus ``COAL_SLACK`` (1 + |d|)),
 
     d(q(s)) ≥ L = (d̲_a + d̲_b − Δ) / 2      for every s ∈ [0, 1],                    (1)
@@ -63,13 +70,31 @@ def _lever_arms3d(robot: Robot3D) -> np.ndarray:
     return arms
 
 
+_PAIR_ARMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # robot -> (P, dof)
+
+
+def self_pair_arms(robot: Robot3D) -> np.ndarray:
+    """(P, dof) weights w_p with δ_στ = w_p · |Δq| for every self pair p = (σ, τ): r_{σ,j}
+    on the joints moving σ but not τ, r_{τ,j} on those moving τ but not σ, 0 on the rest (m)."""
+    if robot not in _PAIR_ARMS:
+        arms, model = lever_arms3d(robot), robot.model
+        moves = np.zeros((len(robot.shapes), robot.dof), bool)
+        for k, shape in enumerate(robot.shapes):
+            for j in list(model.supports[shape.body])[1:]:
+                moves[k, model.joints[j].idx_v] = True
+        a, b = robot.self_pairs[:, 0], robot.self_pairs[:, 1]
+        weights = arms[a] * (moves[a] & ~moves[b]) + arms[b] * (moves[b] & ~moves[a])
+        weights.setflags(write=False)
+        _PAIR_ARMS[robot] = weights.reshape(-1, robot.dof)
+    return _PAIR_ARMS[robot]
+
+
 def motion_bound3d(robot: Robot3D, qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
     """(B,) bound Δ on the change of any pair's distance from qa to qb (B, dof) (m)."""
-    delta = np.abs(np.asarray(qb, float) - np.asarray(qa, float)) @ lever_arms3d(robot).T  # (B, S)
-    out = delta.max(axis=1)
+    step = np.abs(np.asarray(qb, float) - np.asarray(qa, float))
+    out = (step @ lever_arms3d(robot).T).max(axis=1)  # obstacle pairs: max_σ δ_σ
     if len(robot.self_pairs):
-        pairs = delta[:, robot.self_pairs[:, 0]] + delta[:, robot.self_pairs[:, 1]]
-        out = np.maximum(out, pairs.max(axis=1))
+        out = np.maximum(out, (step @ self_pair_arms(robot).T).max(axis=1))
     return out
 
 

@@ -14,8 +14,10 @@ uniformly within the joint limits such that
   configurations on it has a signed distance ≤ 0 (a witnessed collision, so the planner has
   to go around).
 
-Box sizes (:data:`BOX_SIZES`) are chosen per robot so that about 25–40 % of uniformly random
-configurations collide, as in environment (d); :func:`collision_fraction` measures it.
+Box sides and the boxes' clearance from the base's vertical axis (:data:`BOXES`) are chosen
+per robot so that about 25–40 % of uniformly random configurations collide, as in environment
+(d) (:func:`collision_fraction` measures it; the Panda's thinner links need larger boxes, kept
+farther from its base so that no box overlaps its first links at every configuration).
 """
 
 from __future__ import annotations
@@ -33,15 +35,17 @@ from .distance3d import signed_distance3d
 from .robot3d import Robot3D
 from .scene3d import Scene3D, random_boxes
 
-BOX_SIZES = {"ur5e": (0.05, 0.2), "panda": (0.15, 0.3), "ur5": (0.05, 0.2)}  # m, box sides
+# robot -> ((smallest, largest) box side, box centres' distance from the base axis), m
+BOXES = {"ur5e": ((0.05, 0.2), 0.25), "panda": ((0.15, 0.3), 0.35), "ur5": ((0.05, 0.2), 0.25)}
 LINE_SAMPLES = 50  # configurations on the straight line searched for a collision
 MAX_DRAWS = 2000  # (start, goal) draws per problem before giving up
 
 
 def reaching_scene(robot: Robot3D | str, seed: int, boxes: int = 20) -> Scene3D:
-    """The robot among ``boxes`` random boxes of its :data:`BOX_SIZES` (scene seed ``seed``)."""
+    """The robot among ``boxes`` random boxes of its :data:`BOXES` (scene seed ``seed``)."""
     robot = load_robot3d(robot) if isinstance(robot, str) else robot
-    return random_boxes(robot, boxes, seed=seed, size=BOX_SIZES.get(robot.name, (0.05, 0.2)))
+    size, clearance = BOXES.get(robot.name, BOXES["ur5e"])
+    return random_boxes(robot, boxes, seed=seed, size=size, base_clearance=clearance)
 
 
 def collision_fraction(scene: Scene3D, n: int = 500, seed: int = 0) -> float:
@@ -104,4 +108,4 @@ def reaching_problems(
     return problems
 
 
-__all__ = ["BOX_SIZES", "collision_fraction", "reaching_problems", "reaching_scene"]
+__all__ = ["BOXES", "collision_fraction", "reaching_problems", "reaching_scene"]

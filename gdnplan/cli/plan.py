@@ -44,7 +44,7 @@ def show(
     check_output_path(out, FIGURE_SUFFIXES, "--out")
     scene, start = scene_and_start(target, seed)
     if is_3d(scene):
-        raise InputError(f"show: {target} is a 3-D problem; draw it with gdnplan plan --view3d")
+        raise InputError(f"show: {target} is a 3-D problem; show draws planar scenes only")
     if q is not None:
         config = check_limits(
             scene.robot, scene.robot.check_q(parse_vector(q, "--q"), "--q")[0], "--q"
@@ -106,8 +106,9 @@ def plan_command(
     problem = Problem.from_toml(problem_file)
     if collision is None:
         collision = "coal" if is_3d(problem.scene) else "graphdistnet"
-    if animate is not None and is_3d(problem.scene):
-        raise InputError("--animate: planar problems only; view a 3-D plan with --view3d")
+    if is_3d(problem.scene) and (animate is not None or view3d):
+        flag = "--animate" if animate is not None else "--view3d"
+        raise InputError(f"{flag}: planar problems only (the 3-D arms' viewer is not written yet)")
     config = plan_flags_config(problem, solver, seeds, time_budget)
     result = plan(
         problem,
