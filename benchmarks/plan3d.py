@@ -6,8 +6,9 @@ Usage: python benchmarks/plan3d.py --threads 1 [--robots ur5e panda] [--problems
 Problems: :func:`gdnplan.arm3d.problem3d.reaching_problems` (seed 0): for each robot, problem
 i is the robot among 20 random boxes (scene seed i, box sides and base clearance from
 ``BOXES``), a start and a goal clear of the margin (0.02 m) within the joint box (the limits
-cut to ±π), and a straight joint-space line that collides. The share of uniformly random configurations in collision is
-measured on the same scenes (the 3-D counterpart of environment (d)'s 25–40 %).
+cut to ±π), and a straight joint-space line that collides. The share of uniformly random
+configurations in collision is measured on the same scenes (the 3-D counterpart of environment
+(d)'s 25–40 %).
 
 Methods, on every problem in one run:
 
