@@ -4,10 +4,11 @@ Usage: python benchmarks/plan3d.py --threads 1 [--robots ur5e panda] [--problems
        [--rrt-time 5] [--ompl-time 10] [--out benchmarks/results/plan3d.md]
 
 Problems: :func:`gdnplan.arm3d.problem3d.reaching_problems` (seed 0): for each robot, problem
-i is the robot among 20 random boxes (scene seed i, box sides and base clearance from ``BOXES``), a start and
-a goal clear of the margin (0.02 m) within the joint box (the limits cut to ±π), and a straight
-joint-space line that collides. The share of uniformly random configurations in collision is
-measured on the same scenes (the 3-D counterpart of environment (d)'s 25–40 %).
+i is the robot among 20 random boxes (scene seed i, box sides and base clearance from
+``BOXES``), a start and a goal clear of the margin (0.02 m) within the joint box (the limits
+cut to ±π), and a straight joint-space line that collides. The share of uniformly random
+configurations in collision is measured on the same scenes (the 3-D counterpart of environment
+(d)'s 25–40 %).
 
 Methods, on every problem in one run:
 
@@ -27,14 +28,10 @@ and counts as failed unless it certifies. Metrics: success, median wall time, pa
 from __future__ import annotations
 
 import statistics
-import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
+import common
 import numpy as np
-from common import Report, first_paragraph, parse, parser
 
 import gdnplan as gp
 from gdnplan.arm3d.problem3d import BOXES, collision_fraction, reaching_problems
@@ -95,13 +92,15 @@ def summary(rows: list[dict]) -> tuple[str, str, str, str]:
 
 
 def main(argv=None) -> None:
-    p = parser("plan3d", first_paragraph(__doc__))
+    p = common.parser("plan3d", __doc__)
     p.add_argument("--robots", nargs="+", default=["ur5e", "panda"])
     p.add_argument("--problems", type=int, default=20)
     p.add_argument("--rrt-time", type=float, default=5.0, help="gdnplan's RRT-Connect limit (s)")
     p.add_argument("--ompl-time", type=float, default=10.0, help="OMPL planning time limit (s)")
-    args = parse(p, argv)
-    report = Report(args, "Planning in 3-D: gdnplan (coal + Ipopt) and OMPL RRT-Connect", __doc__)
+    args = common.parse(p, argv)
+    report = common.Report(
+        args, "Planning in 3-D: gdnplan (coal + Ipopt) and OMPL RRT-Connect", __doc__
+    )
     totals = report.table(
         "robot", "problems", "colliding configs", "method", "certified", "median time (s)",
         "median path cost (rad²)", "smallest certified clearance (m)",

@@ -34,10 +34,13 @@ BatchFn = Callable[[np.ndarray], tuple[np.ndarray, Callable[[], np.ndarray]]]
 
 def supports_per_link(model: DistanceModel) -> bool:
     """True when the model's ``distance_and_grad`` takes ``per_link`` (coal always does)."""
-    if isinstance(model, CoalModel):
-        return True
+    return isinstance(model, CoalModel) or _takes(model, "per_link")
+
+
+def _takes(model: DistanceModel, name: str) -> bool:
+    """True when the model's ``distance_and_grad`` has a parameter ``name``."""
     try:
-        return "per_link" in inspect.signature(model.distance_and_grad).parameters
+        return name in inspect.signature(model.distance_and_grad).parameters
     except (TypeError, ValueError):
         return False
 
@@ -75,8 +78,10 @@ def distance_rows(
 
         return coal_links, scene.robot.n_links
 
+    capped = _takes(model, "cap")  # the model skips the pairs beyond the cap itself
+
     def links(q: np.ndarray) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
-        d, g = model.distance_and_grad(scene, q, per_link=True)
+        d, g = model.distance_and_grad(scene, q, per_link=True, **({"cap": cap} if capped else {}))
         d = np.asarray(d, float)
         return np.minimum(d, cap), _given(np.asarray(g, float) * (d < cap)[..., None])
 

@@ -96,3 +96,18 @@ def test_coal_is_the_3d_model_and_no_learned_3d_model_ships():
 def test_a_3d_goal_is_a_joint_vector():
     with pytest.raises(InputError, match=r"goal\.position: a 3-D problem's goal is a joint vector"):
         Problem(wall(), START, goal_position=np.array([0.3, 0.2]))
+
+
+def test_the_3d_coal_model_gives_ipopt_one_capped_row_per_link():
+    from gdnplan.casadi_bridge import distance_rows, supports_per_link
+
+    scene, model = wall(), Coal3DModel()
+    assert supports_per_link(model)
+    rows, n = distance_rows(model, scene, per_link=True, cap=0.3)
+    q = line(7)
+    d, grad = rows(q)
+    exact = signed_distance3d(scene, q, per_link=True)
+    assert n == scene.robot.n_links and d.shape == exact.shape
+    np.testing.assert_allclose(d, np.minimum(exact, 0.3), atol=1e-9)
+    g = grad()
+    assert g.shape == (7, n, 6) and np.all(g[d >= 0.3] == 0)

@@ -340,5 +340,10 @@ class Coal3DModel:
     def distance(self, scene: Scene3D, q: np.ndarray) -> np.ndarray:
         return signed_distance3d(scene, q)
 
-    def distance_and_grad(self, scene: Scene3D, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return signed_distance3d_and_grad(scene, q)
+    def distance_and_grad(
+        self, scene: Scene3D, q: np.ndarray, per_link: bool = False, cap: float = np.inf
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Distances and gradients, overall or ``per_link`` ((B, L), (B, L, dof): the Ipopt
+        transcription's one row per link); pairs whose bound reaches ``cap`` (m) are skipped
+        and a link with none below it reports ``cap`` with a zero gradient."""
+        return signed_distance3d_and_grad(scene, q, per_link=per_link, cap=cap)
