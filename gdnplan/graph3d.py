@@ -37,7 +37,7 @@ from .errors import InputError
 
 RIM = 8  # points per cylinder rim on the robot (docs/decisions.md: node count vs accuracy)
 HULL_POINTS = 24  # most vertices kept of a mesh hull
-COPLANAR = 1e-6  # facets whose unit normals differ less than this are one face
+COPLANAR = 1e-10  # facets with 1 − n₁·n₂ below this (unit normals) are one face
 
 
 # -------------------------------------------------------------------- shapes → points
@@ -51,7 +51,7 @@ def fibonacci_sphere(n: int) -> np.ndarray:
 
 
 def farthest_points(points: np.ndarray, n: int) -> np.ndarray:
-    """Indices of n of ``points`` (k, 3) by farthest-point sampling from the first (all if k ≤ n)."""
+    """Indices of n of ``points`` (k, 3), farthest-point sampling from the first (all if k ≤ n)."""
     if len(points) <= n:
         return np.arange(len(points))
     chosen = [0]
@@ -240,9 +240,7 @@ def robot_graph3d(robot: Robot3D, rim: int = RIM, hull_points: int = HULL_POINTS
     for n, i in enumerate(body_arr):
         for j in model.supports[int(i)][1:]:
             support[n, model.joints[j].idx_v] = 1.0
-    return RobotGraph3D(
-        robot, rim, local_arr, body_arr, np.concatenate(link), nbr, mask, support
-    )
+    return RobotGraph3D(robot, rim, local_arr, body_arr, np.concatenate(link), nbr, mask, support)
 
 
 # -------------------------------------------------------------------- obstacle graphs

@@ -66,7 +66,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ompl_planner",
         ),
     ),
-    ("graphs", ("graph",)),
+    ("graphs", ("graph", "graph3d")),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
     ("trajopt", ("trajopt", "trajopt.*", "timing")),

@@ -8,7 +8,13 @@
 """
 
 from .config import GraphDistNet3DConfig
-from .model import GraphDistNet3DModel, forward_with_grad, obstacle_input, robot_tensors
+from .model import (
+    GraphDistNet3DModel,
+    boxes_input,
+    forward_with_grad,
+    obstacle_input,
+    robot_tensors,
+)
 from .network import GraphDistNet3D, ObstacleFeatures, ObstacleInput
 
 __all__ = [
@@ -17,6 +23,7 @@ __all__ = [
     "GraphDistNet3DModel",
     "ObstacleFeatures",
     "ObstacleInput",
+    "boxes_input",
     "forward_with_grad",
     "obstacle_input",
     "robot_tensors",

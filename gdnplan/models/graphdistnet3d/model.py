@@ -21,7 +21,13 @@ import torch
 
 from ...arm3d import Checker3D, Scene3D
 from ...errors import InputError
-from ...graph3d import ObstacleGraph3D, RobotGraph3D, robot_graph3d, scene_graph3d
+from ...graph3d import (
+    ObstacleGraph3D,
+    RobotGraph3D,
+    box_graphs,
+    robot_graph3d,
+    scene_graph3d,
+)
 from ..threads import check_threads, torch_threads
 from .network import GraphDistNet3D, ObstacleFeatures, ObstacleInput
 
@@ -48,6 +54,23 @@ def obstacle_input(
         torch.as_tensor(mask),
         torch.as_tensor(nbr),
         torch.as_tensor(nbr_mask),
+    )
+
+
+def boxes_input(
+    centers: np.ndarray, sizes: np.ndarray, dtype: torch.dtype = torch.float32
+) -> ObstacleInput:
+    """The graphs of S scenes of M axis-aligned boxes, centres and full sides (S, M, 3) (m):
+    :func:`gdnplan.graph3d.box_graphs` of every scene, stacked (no padding: same structure)."""
+    s, m, _ = centers.shape
+    one = box_graphs(np.zeros((m, 3)), np.ones((m, 3)))  # the structure; unit corners ±0.5
+    corners = one.nodes.reshape(m, 8, 3)
+    nodes = (centers[:, :, None] + corners[None] * sizes[:, :, None]).reshape(s, m * 8, 3)
+    return ObstacleInput(
+        torch.as_tensor(nodes, dtype=dtype),
+        torch.ones(s, m * 8, dtype=torch.bool),
+        torch.as_tensor(one.nbr)[None].expand(s, -1, -1),
+        torch.as_tensor(one.nbr_mask)[None].expand(s, -1, -1),
     )
 
 

@@ -66,6 +66,17 @@ class ObstacleFeatures:
     pooled: torch.Tensor
     mask: torch.Tensor
 
+    def take(self, rows: torch.Tensor) -> ObstacleFeatures:
+        """The features of scenes ``rows`` (B,) (long): one row per sample of a batch."""
+        pick = lambda t: None if t is None else t.index_select(0, rows)  # noqa: E731
+        return ObstacleFeatures(
+            pick(self.x0),
+            [pick(v) for v in self.v],
+            [pick(s) for s in self.score],
+            pick(self.pooled),
+            pick(self.mask),
+        )
+
 
 class GraphDistNet3D(nn.Module):
     """The network of :class:`GraphDistNet3DConfig` (module docstring)."""
@@ -105,9 +116,17 @@ class GraphDistNet3D(nn.Module):
         u_j = torch.gather(u, 1, flat).view(b, n, e, h)
         node = first.bias if v_bar is None else v_bar - z @ first.weight[:, d:].T + first.bias
         node = node.expand(b, n, h) if v_bar is None else node
-        pre = torch.cat([u_j - u[:, :, None], torch.zeros_like(u[:, :, None])], 2) + node[:, :, None]
+        pre = (
+            torch.cat([u_j - u[:, :, None], torch.zeros_like(u[:, :, None])], 2) + node[:, :, None]
+        )
         mask = torch.cat([nbr_mask.expand(b, -1, -1), nbr_mask.new_ones(b, n, 1)], 2)
-        return (self.convs[k][1:](pre) * mask[..., None]).sum(2)
+        keep = mask[..., None].to(pre.dtype)
+        last = self.convs[k][-1]  # Σ_e m_e (W a_e + b) = W Σ_e m_e a_e + (Σ_e m_e) b
+        summed = (self.convs[k][1:-1](pre) * keep).sum(2)
+        return (
+            torch.addmm(last.bias, summed.flatten(0, 1), last.weight.T).view(b, n, -1)
+            + (keep.sum(2) - 1) * last.bias
+        )
 
     def pool(self, h: torch.Tensor, k: int, mask: torch.Tensor | None) -> torch.Tensor:
         """LeakyReLU(Σ_i α_i x_i⁽ᵏ⁾) (B, H), α = softmax of a⁽ᵏ⁾ᵀ x⁽ᵏ⁾ over the (masked) nodes."""
@@ -161,7 +180,7 @@ class GraphDistNet3D(nn.Module):
         obstacle features of :meth:`obstacle_pass` (batch B, or 1 for one scene)."""
         xr = self.normalise(robot_nodes)
         idx, log_phi, d2 = self.candidates(xr, feats)
-        b, n, c = idx.shape
+        b = idx.shape[0]
         h, pooled = None, None
         for k in range(self.config.layers):
             z = xr if h is None else torch.cat([xr, h], -1)
