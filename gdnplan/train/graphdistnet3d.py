@@ -56,8 +56,8 @@ class Train3DConfig:
     lr: float = 1e-3
     min_lr: float = 1e-5
     seed: int = 0
-    n_val: int = 1000
-    validate_every: int = 50
+    n_val: int = 500
+    validate_every: int = 10
     grad_weight: float = 0.1
     contact_weight: float = 2.0
     contact_scale: float = 0.02
