@@ -35,7 +35,7 @@ from .arm3d.scene3d import Obstacle3D, Scene3D
 from .arm3d.shapes import bvh_vertices
 from .errors import InputError
 
-RIM = 8  # points per cylinder rim on the robot (docs/decisions.md: node count vs accuracy)
+RIM = 8  # points per cylinder rim (docs/decisions.md#graphdistnet-3d-robot-graph-nodes)
 HULL_POINTS = 24  # most vertices kept of a mesh hull
 COPLANAR = 1e-10  # facets with 1 − n₁·n₂ below this (unit normals) are one face
 

@@ -125,3 +125,34 @@ def test_ray_writes_the_same_shards_as_the_local_pool(tmp_path):
     assert names == sorted(p.name for p in ray.glob("shard_*.npz")) and len(names) == 3
     for name in names:
         assert (local / name).read_bytes() == (ray / name).read_bytes()
+
+
+def test_cloud_shard_labels_are_the_distance_to_the_balls_around_the_points():
+    from gdnplan.data.samples3d import POINT_RADIUS, cloud_scene
+
+    a = make_shard3d("ur5e_cloud", 2, 0, SCENE_SAMPLES)
+    pts = a["points"][0]
+    assert pts.shape == (400, 3) and np.all(pts[:, 2] > -0.05)
+    robot = obstacle_robot("ur5e")
+    rows = np.arange(5)
+    res = Checker3D(cloud_scene(robot, pts)).evaluate(a["q"][rows], broad_phase=False)
+    np.testing.assert_allclose(a["d"][rows], res.distance, atol=1e-9)
+    # independent: distance of every link shape to every point minus the radius, by coal
+    import coal
+
+    tf = robot.shape_placements(a["q"][0])
+    best = np.inf
+    for s, t in zip(robot.shapes, tf, strict=True):
+        for p in pts:
+            r = coal.DistanceResult()
+            d = coal.distance(
+                s.shape,
+                coal.Transform3s(t[:3, :3], t[:3, 3]),
+                coal.Sphere(1e-9),
+                coal.Transform3s(np.eye(3), p),
+                coal.DistanceRequest(),
+                r,
+            )
+            best = min(best, d - POINT_RADIUS)
+    if best > 0:
+        np.testing.assert_allclose(a["d"][0], best, atol=1e-6)

@@ -45,3 +45,21 @@ def test_training_resumes_from_its_checkpoint(split, tmp_path):
     assert again["samples"] == 100 and np.isfinite(again["log"][-1]["mae_m"])
     with pytest.raises(InputError, match="other settings"):
         train3d(split / "train", split / "val", tmp_path, Train3DConfig(batch=10), time_budget=0)
+
+
+def test_cloud_batches_use_the_knn_graph_of_each_scene():
+    import torch
+
+    from gdnplan.data.samples3d import env_robot3d, make_shard3d
+    from gdnplan.graph3d import point_cloud_graph, robot_graph3d
+    from gdnplan.models.graphdistnet3d import GraphDistNet3D, GraphDistNet3DConfig
+    from gdnplan.train.graphdistnet3d import CLOUD_K, Batch3D
+
+    shard = make_shard3d("ur5e_cloud", 0, 0, 50)
+    graph = robot_graph3d(env_robot3d("ur5e_cloud"))
+    b = Batch3D(graph, shard, np.arange(4))
+    knn = point_cloud_graph(shard["points"][0], CLOUD_K)
+    assert b.obstacles.nodes.shape == (1, 400, 3)
+    np.testing.assert_array_equal(b.obstacles.nbr[0].numpy(), knn.nbr)
+    d, g = b.run(GraphDistNet3D(GraphDistNet3DConfig(scale=1.2)), graph, False)
+    assert d.shape == (4,) and g.shape == (4, 6) and torch.isfinite(g).all()

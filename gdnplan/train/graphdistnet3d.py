@@ -33,18 +33,20 @@ import torch
 from ..arm3d.scene3d import workspace_radius
 from ..data.samples3d import env_robot3d
 from ..errors import InputError
-from ..graph3d import robot_graph3d
+from ..graph3d import point_cloud_graph, robot_graph3d
 from ..models.graphdistnet3d import (
     GraphDistNet3D,
     GraphDistNet3DConfig,
     boxes_input,
     forward_with_grad,
+    obstacle_input,
 )
 from ..models.weights import read_card, write_weights
 from .checkpoint import load_checkpoint, save_checkpoint
 from .loss import GraphDistNetLoss, distance_loss, gradient_loss
 from .report import git_sha, metrics
 
+CLOUD_K = 6  # neighbours of a point in a cloud's graph
 PLATEAU = 4  # validations without a better MAE before the learning rate is halved
 
 
@@ -104,7 +106,11 @@ class Batch3D:
         scenes, inverse = np.unique(shard["scene"][rows], return_inverse=True)
         self.nodes = torch.as_tensor(nodes, dtype=torch.float32)
         self.jac = torch.as_tensor(jac, dtype=torch.float32)
-        self.obstacles = boxes_input(shard["box_center"][scenes], shard["box_size"][scenes])
+        if "points" in shard:  # ur5e_cloud: the kNN graph of every scene's cloud
+            graphs = [point_cloud_graph(shard["points"][s], CLOUD_K) for s in scenes]
+            self.obstacles = obstacle_input(graphs)
+        else:
+            self.obstacles = boxes_input(shard["box_center"][scenes], shard["box_size"][scenes])
         self.scene_rows = torch.as_tensor(inverse.reshape(-1), dtype=torch.long)
         self.d = torch.as_tensor(shard["d"][rows], dtype=torch.float32)
         self.grad = torch.as_tensor(shard["grad"][rows], dtype=torch.float32)
