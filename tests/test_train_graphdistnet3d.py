@@ -8,7 +8,14 @@ import pytest
 
 from gdnplan.data.shards3d import generate3d
 from gdnplan.errors import InputError
-from gdnplan.train.graphdistnet3d import Train3DConfig, batches, shard_files, train3d
+from gdnplan.models.weights import read_card
+from gdnplan.train.graphdistnet3d import (
+    Train3DConfig,
+    batches,
+    export_weights,
+    shard_files,
+    train3d,
+)
 
 
 @pytest.fixture(scope="module")
@@ -45,6 +52,9 @@ def test_training_resumes_from_its_checkpoint(split, tmp_path):
     assert again["samples"] == 100 and np.isfinite(again["log"][-1]["mae_m"])
     with pytest.raises(InputError, match="other settings"):
         train3d(split / "train", split / "val", tmp_path, Train3DConfig(batch=10), time_budget=0)
+    card = export_weights(tmp_path, tmp_path / "w.safetensors", split / "val", n_test=30)
+    assert card["test"]["n"] == 30 and card["acceptance"]["met"] is False
+    assert read_card(tmp_path / "w.safetensors")["model"] == "graphdistnet3d"
 
 
 def test_cloud_batches_use_the_knn_graph_of_each_scene():

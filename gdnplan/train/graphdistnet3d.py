@@ -126,13 +126,10 @@ def evaluate3d(net: GraphDistNet3D, folder: Path | str, n: int | None = None, ch
     net.eval()
     graph = robot_graph3d(env_robot3d("ur5e_boxes"), net.config.rim)
     d_hat, g_hat, d, g = [], [], [], []
+    taken = 0
     for f in shard_files(folder):
         shard = read_shard(f)
-        m = (
-            len(shard["d"])
-            if n is None
-            else min(len(shard["d"]), n - len(np.concatenate(d or [[]])))
-        )
+        m = len(shard["d"]) if n is None else min(len(shard["d"]), n - taken)
         for s in range(0, m, chunk):
             b = Batch3D(graph, shard, np.arange(s, min(s + chunk, m)))
             dh, gh = b.run(net, graph, False)
@@ -140,7 +137,8 @@ def evaluate3d(net: GraphDistNet3D, folder: Path | str, n: int | None = None, ch
             g_hat.append(gh.detach().double().numpy())
             d.append(b.d.double().numpy())
             g.append(b.grad.double().numpy())
-        if n is not None and sum(len(x) for x in d) >= n:
+        taken += m
+        if n is not None and taken >= n:
             break
     net.train()
     arrays = [np.concatenate(x) for x in (d_hat, g_hat, d, g)]
