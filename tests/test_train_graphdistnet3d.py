@@ -8,6 +8,7 @@ import pytest
 
 from gdnplan.data.shards3d import generate3d
 from gdnplan.errors import InputError
+from gdnplan.models.graphdistnet3d import load_graphdistnet3d
 from gdnplan.models.weights import read_card
 from gdnplan.train.graphdistnet3d import (
     Train3DConfig,
@@ -55,6 +56,8 @@ def test_training_resumes_from_its_checkpoint(split, tmp_path):
     card = export_weights(tmp_path, tmp_path / "w.safetensors", split / "val", n_test=30)
     assert card["test"]["n"] == 30 and card["acceptance"]["met"] is False
     assert read_card(tmp_path / "w.safetensors")["model"] == "graphdistnet3d"
+    model = load_graphdistnet3d(tmp_path / "w.safetensors")
+    assert model.card["robot"] == "ur5e" and model.config.rim == 8
 
 
 def test_cloud_batches_use_the_knn_graph_of_each_scene():

@@ -8,6 +8,7 @@
 """
 
 from .config import GraphDistNet3DConfig
+from .load import load_graphdistnet3d
 from .model import (
     GraphDistNet3DModel,
     boxes_input,
@@ -25,6 +26,7 @@ __all__ = [
     "ObstacleInput",
     "boxes_input",
     "forward_with_grad",
+    "load_graphdistnet3d",
     "obstacle_input",
     "robot_tensors",
 ]
