@@ -8,9 +8,11 @@ GraphDistNet-3D: the learned robot–obstacle distance (``learned_distance``, un
 the default architecture: the time does not depend on the weights) and the DistanceModel's
 distance with the exact self-collision beside it. Obstacle features are computed once per scene
 before timing (one-way cross edges). The Pinocchio kinematics of the robot graph are timed
-alone too.
+alone too. ``--variants`` adds the learned distance + gradient of smaller architectures
+(``rim:hidden:layers``: points per cylinder rim, d_h = every MLP width, K), untrained.
 
     python benchmarks/graphdistnet3d_speed.py --threads 1 [--n 5000] [--repeats 3]
+        [--variants 6:16:3,4:16:3]
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ def main() -> None:
     p.add_argument("--n", type=int, default=5000, help="configurations")
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--variants", default="6:16:3,4:16:3", help="rim:hidden:layers, comma-separated")
     args = common.parse(p)
     report = common.Report(args, "GraphDistNet-3D vs coal-3D", common.first_paragraph(__doc__))
     robot = load_robot3d("ur5e")
@@ -58,6 +61,21 @@ def main() -> None:
         ),
         "robot graph kinematics (Pinocchio) alone": lambda: graph.kinematics(q),
     }
+    for variant in filter(None, args.variants.split(",")):
+        rim, hidden, layers = (int(x) for x in variant.split(":"))
+        config = GraphDistNet3DConfig(
+            scale=workspace_radius(robot),
+            rim=rim,
+            hidden=hidden,
+            mlp=(hidden,) * 3,
+            readout=(hidden,) * 3,
+            layers=layers,
+        )
+        small = GraphDistNet3DModel(GraphDistNet3D(config), threads=args.threads)
+        small.distance(scene, q[:2])
+        nodes = robot_graph3d(robot, rim).n_nodes
+        name = f"GraphDistNet-3D {nodes} nodes, d_h = {hidden}, K = {layers}: distance + gradient"
+        calls[name] = lambda m=small: m.learned_distance_and_grad(scene, q)
     report.text(
         f"{args.n} configurations, 20 boxes (seed {args.seed}), {graph.n_nodes} robot nodes, "
         f"{len(scene.obstacles) * 8} obstacle nodes; best and median of {args.repeats} rounds."

@@ -48,10 +48,10 @@ def test_scene_vector_needs_exactly_the_boxes():
 
 
 def test_a_short_fit_beats_the_mean(tmp_path):
-    generate3d("ur5e_boxes", 300, 0, tmp_path, workers=1, shard_size=100)
+    generate3d("ur5e_boxes", 200, 0, tmp_path, workers=1, shard_size=100)
     data = load_arrays(tmp_path)
-    assert len(data["d"]) == 300 and data["boxes"].shape == (300, 120)
-    net, summary = train_clearancenet3d(data, scale=1.2, seconds=2.0, batch=64)
+    assert len(data["d"]) == 200 and data["boxes"].shape == (200, 120)
+    net, summary = train_clearancenet3d(data, scale=1.2, seconds=1.0, batch=64)
     m = evaluate_clearancenet3d(net, data)
     assert summary["epochs"] >= 1
     assert m["mae_m"] < np.mean(np.abs(data["d"] - data["d"].mean()))
