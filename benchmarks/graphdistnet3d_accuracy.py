@@ -93,7 +93,8 @@ def main() -> None:
             f"{m['collision_fraction']:.0%}",
         )
     report.text(
-        f"GraphDistNet-3D largest |Δd̂| per step of ≤ 0.003 rad per joint along 5 sweeps of 100 steps: {1e3 * sweep_step(net):.3f} mm."
+        "GraphDistNet-3D largest |Δd̂| per step of ≤ 0.003 rad per joint along 5 sweeps of "
+        f"100 steps: {1e3 * sweep_step(net):.3f} mm."
     )
     report.write()
 
