@@ -4,7 +4,8 @@ A graph's nodes are points of the geometry (features: world coordinates, m) and 
 the geometry's own: for a convex shape, the edges of the convex polytope of its nodes (hull
 edges: the edges of scipy's Qhull triangulation between facets that are not coplanar, so a box
 has its 12 edges, a sampled cylinder its two rims and the lines between them); for a point
-cloud, the symmetrised k-nearest-neighbour graph. Node degrees differ, so a graph stores its
+cloud (an array of points, or a coal octree obstacle: its occupied voxels' centres), the
+symmetrised k-nearest-neighbour graph. Node degrees differ, so a graph stores its
 neighbourhoods padded to the largest degree D with a mask: ``nbr`` (N, D) node indices (padded
 slots point to the node itself) and ``nbr_mask`` (N, D).
 
@@ -278,11 +279,15 @@ def union(graphs: list[ObstacleGraph3D]) -> ObstacleGraph3D:
     return ObstacleGraph3D(np.concatenate(nodes), np.concatenate(nbr), np.concatenate(mask))
 
 
-def obstacle_graph3d(obstacle: Obstacle3D, rim: int = RIM) -> ObstacleGraph3D:
-    """The graph of one convex obstacle: its shape's points (:func:`shape_points`) posed in the
-    world, with its polytope's edges."""
-    pts = shape_points(obstacle.shape, rim)
+def obstacle_graph3d(obstacle: Obstacle3D, rim: int = RIM, k: int = 6) -> ObstacleGraph3D:
+    """The graph of one obstacle posed in the world: a convex shape's points
+    (:func:`shape_points`) with its polytope's edges; a coal octree (a sensor's point cloud as
+    coal sees it) as the k-nearest-neighbour graph of its occupied voxels' centres."""
     rot, trans = np.asarray(obstacle.pose.getRotation()), np.asarray(obstacle.pose.getTranslation())
+    if isinstance(obstacle.shape, coal.OcTree):
+        centres = np.asarray(obstacle.shape.toBoxes(), dtype=float).reshape(-1, 6)[:, :3]
+        return point_cloud_graph(centres @ rot.T + trans, k)
+    pts = shape_points(obstacle.shape, rim)
     return graph_of_points(pts @ rot.T + trans, hull_edges(pts))
 
 
@@ -295,9 +300,9 @@ def point_cloud_graph(points, k: int = 6) -> ObstacleGraph3D:
 
 
 def scene_graph3d(scene: Scene3D, clouds=(), k: int = 6, rim: int = RIM) -> ObstacleGraph3D:
-    """The obstacle graph of a scene: every obstacle's graph and the kNN graph of each point
-    cloud in ``clouds`` ((n_i, 3) arrays, m)."""
-    graphs = [obstacle_graph3d(o, rim) for o in scene.obstacles]
+    """The obstacle graph of a scene: every obstacle's graph (:func:`obstacle_graph3d`) and the
+    kNN graph of each point cloud in ``clouds`` ((n_i, 3) arrays, m)."""
+    graphs = [obstacle_graph3d(o, rim, k) for o in scene.obstacles]
     graphs += [point_cloud_graph(c, k) for c in clouds]
     return union(graphs)
 

@@ -171,3 +171,22 @@ def test_scene_graph_joins_obstacles_and_clouds(ur5e):
     assert g.n_nodes == 24 + 30
     assert np.all(g.nbr[24:][g.nbr_mask[24:]] >= 24)  # cloud edges stay in the cloud
     assert np.all(g.nbr[:24][g.nbr_mask[:24]] < 24)
+
+
+def test_octree_obstacles_are_the_knn_graph_of_their_voxels(ur5e):
+    import coal
+
+    from gdnplan.arm3d import Scene3D, obstacle
+
+    pts = np.random.default_rng(0).uniform(-0.1, 0.1, (200, 3))
+    tree = coal.makeOctree(pts, 0.02)
+    scene = Scene3D(ur5e, [obstacle(tree, (0.5, 0.0, 0.3), name="cloud")])
+    g = scene_graph3d(scene, k=5)
+    centres = np.asarray(tree.toBoxes())[:, :3] + [0.5, 0.0, 0.3]
+    np.testing.assert_allclose(g.nodes, centres, atol=1e-12)
+    knn = point_cloud_graph(centres, 5)
+    np.testing.assert_array_equal(g.nbr, knn.nbr)
+    # every voxel centre lies within half a voxel diagonal of a cloud point
+    shifted = pts + np.array([0.5, 0.0, 0.3])
+    near = np.linalg.norm(centres[:, None] - shifted[None], axis=-1).min(1)
+    assert near.max() <= 0.02 * np.sqrt(3) / 2 + 1e-9
