@@ -8,7 +8,8 @@ import pytest
 
 from gdnplan.data.shards3d import generate3d
 from gdnplan.errors import InputError
-from gdnplan.models.graphdistnet3d import load_graphdistnet3d
+from gdnplan.models import load_model
+from gdnplan.models.graphdistnet3d import GraphDistNet3DModel, load_graphdistnet3d
 from gdnplan.models.weights import read_card
 from gdnplan.train.graphdistnet3d import (
     Train3DConfig,
@@ -58,6 +59,7 @@ def test_training_resumes_from_its_checkpoint(split, tmp_path):
     assert read_card(tmp_path / "w.safetensors")["model"] == "graphdistnet3d"
     model = load_graphdistnet3d(tmp_path / "w.safetensors")
     assert model.card["robot"] == "ur5e" and model.config.rim == 8
+    assert isinstance(load_model(tmp_path / "w.safetensors"), GraphDistNet3DModel)
 
 
 def test_cloud_batches_use_the_knn_graph_of_each_scene():
