@@ -5,14 +5,14 @@ graph nodes (:func:`gdnplan.graph3d.shape_points`) and coal's robot–obstacle s
 that robot is compared with the true one (obstacle pairs only) on random configurations among
 20 random boxes: the error a graph of that many nodes commits by its geometry alone.
 
-    python benchmarks/graph3d_nodes.py [--configs 300] [--scenes 3]
+    python benchmarks/graph3d_nodes.py --threads 1 [--configs 300] [--scenes 3]
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 
+import common
 import numpy as np
 
 from gdnplan.arm3d import Checker3D, Robot3D, Scene3D, load_robot3d, random_boxes
@@ -35,14 +35,22 @@ def node_robot(robot: Robot3D, rim: int) -> Robot3D:
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__)
+    p = common.parser("graph3d_nodes", __doc__)
     p.add_argument("--configs", type=int, default=300)
     p.add_argument("--scenes", type=int, default=3)
-    a = p.parse_args()
+    a = common.parse(p)
+    report = common.Report(
+        a, "Robot graph nodes vs distance accuracy", common.first_paragraph(__doc__)
+    )
+    report.text(
+        f"UR5e, {a.configs} random configurations in each of {a.scenes} scenes of 20 random "
+        "boxes (seeds 1000 …); |coal distance of the node-hull robot − true distance|."
+    )
+    table = report.table(
+        "rim points", "robot nodes", "MAE (mm)", "95 % abs err (mm)", "max abs err (mm)"
+    )
     robot = load_robot3d("ur5e")
     exact = without_self(robot)
-    print("| rim points | robot nodes | MAE (mm) | 95 % abs err (mm) | max abs err (mm) |")
-    print("|---|---|---|---|---|")
     for rim in (4, 6, 8, 12, 16):
         approx = node_robot(robot, rim)
         errs = []
@@ -54,10 +62,8 @@ def main() -> None:
             errs.append(np.abs(d_nodes - d))
         e = np.concatenate(errs) * 1e3
         n = robot_graph3d(robot, rim).n_nodes
-        print(
-            f"| {rim} | {n} | {e.mean():.2f} | {np.percentile(e, 95):.2f} | {e.max():.2f} |",
-            flush=True,
-        )
+        table.add(rim, n, f"{e.mean():.2f}", f"{np.percentile(e, 95):.2f}", f"{e.max():.2f}")
+    report.write()
 
 
 if __name__ == "__main__":
