@@ -47,7 +47,7 @@ from .loss import GraphDistNetLoss, distance_loss, gradient_loss
 from .report import git_sha, metrics
 
 CLOUD_K = 6  # neighbours of a point in a cloud's graph
-PLATEAU = 4  # validations without a better MAE before the learning rate is halved
+PLATEAU = 20  # validations (of 10 steps) without a better MAE before the learning rate is halved
 
 
 @dataclass(frozen=True)
