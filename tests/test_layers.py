@@ -73,7 +73,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ompl_planner",
         ),
     ),
-    ("graphs", ("graph",)),
+    ("graphs", ("graph", "graph3d")),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
     ("trajopt", ("trajopt", "trajopt.*", "timing", "arm3d.problem3d")),

@@ -20,7 +20,7 @@ from .common import set_threads
 
 @app.command("generate")
 def generate_command(
-    env: str = typer.Option(..., help="Environment: a-e or ur5e."),
+    env: str = typer.Option(..., help="Environment: a-e, ur5e, or ur5e_boxes (3-D)."),
     split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
     n: int = typer.Option(None, min=1, help="Samples (default: the paper's 50 000 / 5 000)."),
     seed: int = typer.Option(None, min=0, help="Override the split's seed."),
@@ -31,14 +31,35 @@ def generate_command(
     ),
     workers: int = typer.Option(None, min=1, help="Worker processes (default: all cores)."),
     data: Path = typer.Option(None, help="Data root (default data/): <data>/<env>/<split>."),
+    ray: bool = typer.Option(
+        False,
+        "--ray",
+        help="3-D environments: make the shards as Ray tasks (a local Ray instance).",
+    ),
+    ray_address: str = typer.Option(
+        None, help="With --ray: the Ray cluster to join (e.g. auto, ray://head:10001)."
+    ),
 ) -> None:
     """Write a dataset of graphs and coal labels in resumable shards (finished shards are kept)."""
     from ..data import DATA_DIR, SPLITS, generate, split_dir
+    from ..data.samples3d import ENVS3D
 
     if split not in SPLITS:
         raise InputError(f"--split: expected one of {sorted(SPLITS)}, got {split!r}")
     split_seed, size = SPLITS[split]
+    if ray_address is not None and not ray:
+        raise InputError("--ray-address: needs --ray")
+    if ray and env not in ENVS3D:
+        raise InputError(f"--ray: only for the 3-D environments {list(ENVS3D)}, not {env!r}")
     target = check_output_dir(split_dir(env, split, data or DATA_DIR), "--data")
+    if env in ENVS3D:
+        from ..data.shards3d import generate3d
+
+        seed = split_seed if seed is None else seed
+        backend = (ray_address or "local") if ray else None
+        generate3d(env, size if n is None else n, seed, target, workers, near, backend)
+        typer.echo(f"wrote {target}")
+        return
     generate(
         env, size if n is None else n, split_seed if seed is None else seed, target, workers, near
     )

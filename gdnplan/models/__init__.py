@@ -57,7 +57,8 @@ def load_model(weights: Path | str, threads: int | None = None) -> DistanceModel
     ``weights``: a shipped name (``"d"``, ``"ur5e"``, ``"clearancenet_b"``; see
     :func:`gdnplan.assets.weights_names`) or a path to a ``.safetensors`` file whose JSON card
     sits beside it. The card's ``"model"`` field selects the class (``"graphdistnet"``,
-    ``"clearancenet"``). The model refuses scenes of a robot it was not trained for.
+    ``"clearancenet"``, ``"graphdistnet3d"``). The model refuses scenes of a robot it was not
+    trained for.
     ``threads``: torch threads of its inference (None: the library default, 1;
     :mod:`gdnplan.models.threads`); the model's ``threads`` attribute can be changed later.
     """
@@ -73,6 +74,10 @@ def load_model(weights: Path | str, threads: int | None = None) -> DistanceModel
         from .clearancenet import load as load_clearancenet
 
         return load_clearancenet(path, threads)
+    if kind == "graphdistnet3d":
+        from .graphdistnet3d import load_graphdistnet3d
+
+        return load_graphdistnet3d(path, threads)
     raise UnknownNameError(f"model: unknown model type {kind!r} in {card_path(path).name}")
 
 

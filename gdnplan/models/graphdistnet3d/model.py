@@ -1,0 +1,208 @@
+"""GraphDistNet-3D as a :class:`~gdnplan.models.DistanceModel` of 3-D scenes (the interface of
+:class:`~gdnplan.arm3d.Coal3DModel`), and its inputs from graphs.
+
+q → node positions and WORLD joint Jacobian columns (:meth:`RobotGraph3D.kinematics`, Pinocchio,
+float64) → d̂ of the robot–obstacle distance (``dtype``, chunks of ``chunk`` configurations) →
+∂d̂/∂p_n by autograd on the node coordinates → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
+(:meth:`RobotGraph3D.pullback`). The obstacle features are computed once per scene object
+(one-way cross edges) and cached. Self-collision stays exact (``self_collision=True``): the
+reported distance is min(d̂, d_self) with d_self coal's signed distance over the robot's enabled
+self pairs (:class:`~gdnplan.arm3d.Checker3D` of the robot alone), and the gradient is the
+minimiser's.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ...arm3d import Checker3D, Scene3D
+from ...errors import InputError
+from ...graph3d import (
+    ObstacleGraph3D,
+    RobotGraph3D,
+    box_graphs,
+    robot_graph3d,
+    scene_graph3d,
+)
+from ..threads import check_threads, torch_threads
+from .network import GraphDistNet3D, ObstacleFeatures, ObstacleInput
+
+CHUNK = 256  # configurations per inference pass
+
+
+def obstacle_input(
+    graphs: list[ObstacleGraph3D], dtype: torch.dtype = torch.float32
+) -> ObstacleInput:
+    """Obstacle graphs of S scenes padded into one :class:`ObstacleInput` (S, N_o)."""
+    n = max(g.n_nodes for g in graphs)
+    e = max(g.nbr.shape[1] for g in graphs)
+    s = len(graphs)
+    nodes = np.zeros((s, n, 3))
+    mask = np.zeros((s, n), bool)
+    nbr = np.broadcast_to(np.arange(n)[None, :, None], (s, n, e)).copy()
+    nbr_mask = np.zeros((s, n, e), bool)
+    for i, g in enumerate(graphs):
+        k, d = g.n_nodes, g.nbr.shape[1]
+        nodes[i, :k], mask[i, :k] = g.nodes, True
+        nbr[i, :k, :d], nbr_mask[i, :k, :d] = g.nbr, g.nbr_mask
+    return ObstacleInput(
+        torch.as_tensor(nodes, dtype=dtype),
+        torch.as_tensor(mask),
+        torch.as_tensor(nbr),
+        torch.as_tensor(nbr_mask),
+    )
+
+
+def boxes_input(
+    centers: np.ndarray, sizes: np.ndarray, dtype: torch.dtype = torch.float32
+) -> ObstacleInput:
+    """The graphs of S scenes of M axis-aligned boxes, centres and full sides (S, M, 3) (m):
+    :func:`gdnplan.graph3d.box_graphs` of every scene, stacked (no padding: same structure)."""
+    s, m, _ = centers.shape
+    one = box_graphs(np.zeros((m, 3)), np.ones((m, 3)))  # the structure; unit corners ±0.5
+    corners = one.nodes.reshape(m, 8, 3)
+    nodes = (centers[:, :, None] + corners[None] * sizes[:, :, None]).reshape(s, m * 8, 3)
+    return ObstacleInput(
+        torch.as_tensor(nodes, dtype=dtype),
+        torch.ones(s, m * 8, dtype=torch.bool),
+        torch.as_tensor(one.nbr)[None].expand(s, -1, -1),
+        torch.as_tensor(one.nbr_mask)[None].expand(s, -1, -1),
+    )
+
+
+def robot_tensors(graph: RobotGraph3D) -> tuple[torch.Tensor, torch.Tensor]:
+    """The robot graph's neighbourhoods (N_r, E) as torch tensors (long, bool)."""
+    return torch.as_tensor(graph.nbr), torch.as_tensor(graph.nbr_mask)
+
+
+def forward_with_grad(
+    net: GraphDistNet3D,
+    graph: RobotGraph3D,
+    nodes: torch.Tensor,
+    jac: torch.Tensor,
+    feats: ObstacleFeatures,
+    create_graph: bool,
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """d̂ (B,) and ∂d̂/∂q (B, dof) = Σ_n ∂d̂/∂p_n · J_n, J (B, N_r, 3, dof) (training)."""
+    nbr, nbr_mask = robot_tensors(graph)
+    x = nodes.detach().requires_grad_(True)
+    with torch.enable_grad():
+        d = net(x, nbr, nbr_mask, feats)
+        (dx,) = torch.autograd.grad(d.sum(), x, create_graph=create_graph)
+    return d, torch.einsum("bni,bnij->bj", dx, jac)
+
+
+@dataclass(frozen=True)
+class _SceneCache:
+    graph: RobotGraph3D
+    nbr: torch.Tensor
+    nbr_mask: torch.Tensor
+    feats: ObstacleFeatures
+    self_checker: Checker3D | None
+
+
+class GraphDistNet3DModel:
+    """A trained GraphDistNet-3D as a DistanceModel of :class:`~gdnplan.arm3d.Scene3D` s."""
+
+    name = "graphdistnet3d"
+
+    def __init__(
+        self,
+        net: GraphDistNet3D,
+        card: dict | None = None,
+        self_collision: bool = True,
+        chunk: int = CHUNK,
+        dtype: torch.dtype = torch.float32,
+        threads: int | None = None,
+    ):
+        self.net = net.to(dtype=dtype).eval()
+        self.config = net.config
+        self.card = card or {}
+        self.self_collision = self_collision
+        self.chunk = chunk
+        self.dtype = dtype
+        self.threads = check_threads(threads)
+        self._scenes: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    def check_scene(self, scene: Scene3D) -> None:
+        """InputError unless ``scene`` is a Scene3D of the robot the weights were trained for."""
+        if not isinstance(scene, Scene3D):
+            raise InputError(f"scene: GraphDistNet-3D needs a Scene3D, got {type(scene).__name__}")
+        robot = self.card.get("robot")
+        if robot is not None and robot != scene.robot.name:
+            raise InputError(
+                f"scene: these weights were trained for robot {robot!r}, not {scene.robot.name!r}"
+            )
+        if not scene.obstacles:
+            raise InputError("scene.obstacles: GraphDistNet-3D needs at least one obstacle")
+
+    def _cache(self, scene: Scene3D) -> _SceneCache:
+        cached = self._scenes.get(scene)
+        if cached is None:
+            self.check_scene(scene)
+            graph = robot_graph3d(scene.robot, self.config.rim)
+            obs = obstacle_input([scene_graph3d(scene, rim=self.config.rim)], self.dtype)
+            with torch.inference_mode(False), torch.no_grad():
+                feats = self.net.obstacle_pass(obs)
+            checker = None
+            if self.self_collision and len(scene.robot.self_pairs):
+                checker = Checker3D(Scene3D(scene.robot, ()))
+            nbr, mask = robot_tensors(graph)
+            cached = self._scenes[scene] = _SceneCache(graph, nbr, mask, feats, checker)
+        return cached
+
+    def _chunks(self, n: int) -> list[slice]:
+        return [slice(s, min(s + self.chunk, n)) for s in range(0, n, self.chunk)]
+
+    def learned_distance(self, scene: Scene3D, q) -> np.ndarray:
+        """(B,) d̂ of the robot–obstacle distance alone (m)."""
+        q = scene.robot.check_q(q)
+        with torch_threads(self.threads):
+            c = self._cache(scene)
+            with torch.inference_mode():
+                out = [
+                    self.net(self._tensor(c.graph.positions(q[s])), c.nbr, c.nbr_mask, c.feats)
+                    for s in self._chunks(len(q))
+                ]
+        return torch.cat(out).double().numpy()
+
+    def learned_distance_and_grad(self, scene: Scene3D, q) -> tuple[np.ndarray, np.ndarray]:
+        """(B,), (B, dof): d̂ of the robot–obstacle distance (m) and ∂d̂/∂q (m/rad)."""
+        q = scene.robot.check_q(q)
+        ds, gs = [], []
+        with torch_threads(self.threads):
+            c = self._cache(scene)
+            for s in self._chunks(len(q)):
+                nodes, jac = c.graph.kinematics(q[s])
+                x = self._tensor(nodes).requires_grad_(True)
+                with torch.enable_grad():
+                    d = self.net(x, c.nbr, c.nbr_mask, c.feats)
+                    (dx,) = torch.autograd.grad(d.sum(), x)
+                ds.append(d.detach().double().numpy())
+                gs.append(c.graph.pullback(nodes, jac, dx.double().numpy()))
+        return np.concatenate(ds), np.concatenate(gs)
+
+    def _tensor(self, x: np.ndarray) -> torch.Tensor:
+        return torch.as_tensor(x, dtype=self.dtype)
+
+    def distance(self, scene: Scene3D, q) -> np.ndarray:
+        """(B,) min(d̂, exact self-collision distance) (m) of q (B, dof) or (dof,)."""
+        d = self.learned_distance(scene, q)
+        checker = self._cache(scene).self_checker
+        if checker is None:
+            return d
+        return np.minimum(d, checker.evaluate(q).distance)
+
+    def distance_and_grad(self, scene: Scene3D, q) -> tuple[np.ndarray, np.ndarray]:
+        """((B,), (B, dof)): the distance of :meth:`distance` and its gradient (m/rad)."""
+        d, g = self.learned_distance_and_grad(scene, q)
+        checker = self._cache(scene).self_checker
+        if checker is None:
+            return d, g
+        res = checker.evaluate(q, gradient=True)
+        own = res.distance < d
+        return np.where(own, res.distance, d), np.where(own[:, None], res.gradient, g)
