@@ -73,7 +73,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
     (
         "paper reproduction",
-        ("env_models", "evaluate", "table2", "fetch", "viz", "viz3d", "viz3d.*"),
+        ("env_models", "evaluate", "table2", "ablation", "fetch", "viz", "viz3d", "viz3d.*"),
     ),
     ("cli", ("cli", "cli.*", "__init__")),
 ]
