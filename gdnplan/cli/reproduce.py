@@ -103,7 +103,7 @@ def table1_command(
         "",
         "",
     ]
-    text = "\n".join(header) + ev.table1_markdown(results) + "\n"
+    text = "\n".join(header) + ev.table1_markdown(results, weights) + "\n"
     typer.echo(text)
     write_text(out, text, "--out")
     if figures is not None:
