@@ -35,6 +35,23 @@ from .data import DATA_DIR, split_dir
 from .models.graphdistnet import GraphDistNetConfig
 from .train import FitConfig, GraphDistNetLoss, TrainConfig
 
+__all__ = [
+    "BEST",
+    "ENVS",
+    "STEPS",
+    "Best",
+    "Settings",
+    "faithful_config",
+    "grad_time",
+    "markdown",
+    "run",
+    "score",
+    "step_config",
+    "sweep_max",
+    "table2_ipopt",
+    "train_step",
+]
+
 # (name, what changes, the one field changed), cumulative from the paper's network.
 STEPS: tuple[tuple[str, str, dict], ...] = (
     ("faithful", "the paper (§IV): random, then argmax partner per graph, two-way", {}),
