@@ -268,8 +268,9 @@ def network_line(card: dict) -> str:
 NOTES = """
 Notes (how each number is made; `paper` columns are the paper's Table I):
 
-- Samples: the first n of `data/<env>/test` (seed 1, one obstacle set per sample in b, d, e);
-  the same samples for every method. MAE, AUC and time over n; ACD over the first n_grad
+- Samples: the first n of `data/<env>/test` (seed 1, one obstacle set per sample in b, d, e),
+  or without it the same samples labelled here (`gdnplan.data.split_samples`); the same
+  samples for every method. MAE, AUC and time over n; ACD over the first n_grad
   ([n] in the ACD column, all n by default; the paper sampled 100 gradients), ± its standard
   error s/√n, coal's exact gradient as reference, rows with a zero coal gradient left out.
   AUC: positives are coal's f ≤ 0, the score is −d̂.
