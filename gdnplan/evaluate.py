@@ -176,10 +176,25 @@ def diffco_rows(env: str, ds: Dataset, s: TableSettings) -> list[Result]:
     return rows
 
 
+GDN = "GraphDistNet (gdnplan)"  # the shipped weights/<env>
+FAITHFUL = "GraphDistNet (paper architecture, this implementation)"  # weights/<env>_faithful
+PAPER_ROW = {GDN: "GraphDistNet", FAITHFUL: "GraphDistNet"}  # rows beside the paper's row
+GRAPHDISTNET_FILES = {GDN: "{env}.safetensors", FAITHFUL: "{env}_faithful.safetensors"}
+
+
+def _not_trained(method: str, env: str) -> Result:
+    """The row of missing weights: shown as 'not trained yet' (``score`` None)."""
+    nan = float("nan")
+    return Result(method, env, 0, nan, None, None, nan, None, None, 0, None, None)
+
+
 def table1_env(
     env: str, s: TableSettings, weights_dir: Path = WEIGHTS_DIR, used: dict | None = None
 ) -> tuple[list[Result], float | None]:
-    """All methods on one environment, and Welch's p of GraphDistNet vs ClearanceNet errors."""
+    """All methods on one environment, and Welch's p of GraphDistNet (gdnplan) vs ClearanceNet
+    errors. Both GraphDistNet rows are listed; missing weights give a 'not trained yet' row."""
+    from .models import load_model
+
     ds = test_set(env, s.n)
     (_, _), coal_s = timed(lambda: coal_predict(ds, grad=False))
     rows = [
@@ -187,31 +202,75 @@ def table1_env(
     ]
     rows += diffco_rows(env, ds, s)
     learned = {}
-    files = {
-        "ClearanceNet": f"clearancenet_{env}.safetensors",
-        "GraphDistNet": f"{env}.safetensors",
-    }
-    for name, loader in (
-        ("ClearanceNet", clearancenet_of_env),
-        ("GraphDistNet", graphdistnet_of_env),
-    ):
-        if used is not None and (Path(weights_dir) / files[name]).exists():
-            used[files[name]] = sha256_prefix(Path(weights_dir) / files[name])
-        model = loader(env, weights_dir)
-        if model is not None:
-            learned[name] = evaluate_model(model, env, s.n, s.n_grad, ds=ds)
-            rows.append(replace(learned[name], method=name))
-    p = None
-    if len(learned) == 2:
-        p = welch_p_value(learned["GraphDistNet"].abs_error, learned["ClearanceNet"].abs_error)
-    return rows, p
+    files = {"ClearanceNet": f"clearancenet_{env}.safetensors"}
+    files |= {name: f.format(env=env) for name, f in GRAPHDISTNET_FILES.items()}
+    for name, file in files.items():
+        path = Path(weights_dir) / file
+        if not path.exists():
+            if name in PAPER_ROW:
+                rows.append(_not_trained(name, env))
+            continue
+        if used is not None:
+            used[file] = sha256_prefix(path)
+        if name == "ClearanceNet":
+            model = clearancenet_of_env(env, weights_dir)
+        else:
+            model = BatchedGraphDistNet(load_model(path))
+        learned[name] = evaluate_model(model, env, s.n, s.n_grad, ds=ds)
+        rows.append(replace(learned[name], method=name))
+    return rows, _welch(rows, GDN)
+
+
+def _welch(rows: list[Result], method: str) -> float | None:
+    """Welch's p of ``method``'s absolute errors vs ClearanceNet's (None without both)."""
+    errors = {r.method: r.abs_error for r in rows if r.abs_error is not None}
+    if method not in errors or "ClearanceNet" not in errors:
+        return None
+    return welch_p_value(errors[method], errors["ClearanceNet"])
+
+
+def network_line(card: dict) -> str:
+    """One line saying what a GraphDistNet card's network and training are."""
+    from .train import split_config
+
+    flat = {**card.get("config", {}), **card.get("training", {}).get("loss", {})}
+    net, loss = split_config(flat)
+    parts = [
+        "soft nearest-node partners" if net.cross == "soft_knn" else
+        f"random (one per {net.random_pick}), then argmax partners",
+        "two-way cross edges" if net.two_way else "one-way cross edges",
+    ]  # fmt: skip
+    if net.node_distance:
+        parts.append("node distances")
+    if net.min_readout:
+        parts.append("soft-minimum readout")
+    if net.probe_split > 1:
+        parts.append(f"probe points ({net.probe_split - 1} per edge)")
+    if net.correction_band is not None:
+        parts.append(f"band readout ({100 * net.correction_band:g} cm)")
+    terms = ["distance"]
+    if loss.contact_weight:
+        terms.append(f"contact weight μ = {loss.contact_weight:g}")
+    if loss.grad_weight:
+        terms.append(f"gradient λ = {loss.grad_weight:g}")
+    if loss.grad_norm_weight:
+        terms.append(f"slope ν = {loss.grad_norm_weight:g}")
+    data, training = card.get("data", {}), card.get("training", {})
+    near = sum((data.get("extra") or {}).values())
+    samples = f"{data.get('n_train', 0):,}".replace(",", " ") + " training samples"
+    samples += f" ({near:,} near contact)".replace(",", " ") if near else ""
+    seconds = f"{training.get('seconds', 0):.0f} s of training"
+    if card.get("init"):
+        seconds = f"fine-tuned in steps (card lineage), the last {seconds}"
+    return f"{', '.join(parts)}; loss: {' + '.join(terms)}; {samples}; {seconds}"
 
 
 NOTES = """
 Notes (how each number is made; `paper` columns are the paper's Table I):
 
-- Samples: the first n of `data/<env>/test` (seed 1, one obstacle set per sample in b, d, e);
-  the same samples for every method. MAE, AUC and time over n; ACD over the first n_grad
+- Samples: the first n of `data/<env>/test` (seed 1, one obstacle set per sample in b, d, e),
+  or without it the same samples labelled here (`gdnplan.data.split_samples`); the same
+  samples for every method. MAE, AUC and time over n; ACD over the first n_grad
   ([n] in the ACD column, all n by default; the paper sampled 100 gradients), ± its standard
   error s/√n, coal's exact gradient as reference, rows with a zero coal gradient left out.
   AUC: positives are coal's f ≤ 0, the score is −d̂.
@@ -231,6 +290,14 @@ Notes (how each number is made; `paper` columns are the paper's Table I):
   pool 200 uniform configurations per adapted scene; time = mean adaptation time per scene
   × n (extrapolated, as the paper adapts to every test scene). The paper's DiffCo w/ AL ran out
   of memory in e, hence no paper numbers there.
+- GraphDistNet (gdnplan): the shipped `weights/<env>`, the planner's network (soft
+  nearest-node partners and, per environment, the changes beyond the paper listed below).
+  GraphDistNet (paper architecture, this implementation): `weights/<env>_faithful`, §IV as
+  written (a random, then the argmax partner per graph, two-way cross edges, no node
+  distances, the squared distance loss), trained on the same data for the same seconds as the
+  gdnplan row (`gdnplan reproduce faithful --env <env>`); weights with "one per node" below
+  predate the paper's one-partner-per-graph reading and trained on less (36 000 samples).
+  Both rows stand beside the paper's GraphDistNet numbers.
 - ClearanceNet: MLP 3×256 ReLU on [q/π, obstacle poses (centre, cos 4θ, sin 4θ) or padded
   α-shape vertices], dropout 0.5 for d and e, Adam on data/<env>/train (weights card: data,
   epochs, seconds); a 120 s training budget per environment on this CPU.
@@ -241,27 +308,37 @@ def _num(v: float | None, fmt: str) -> str:
     return "–" if v is None or (isinstance(v, float) and np.isnan(v)) else format(v, fmt)
 
 
-def _p_text(p: float | None, rows: list[Result]) -> str:
-    """Welch's p with the side whose MAE is lower (the test itself is two-sided)."""
+def _p_text(method: str, rows: list[Result]) -> str:
+    """Welch's p of ``method`` vs ClearanceNet with the side whose MAE is lower (the test
+    itself is two-sided)."""
+    p = _welch(rows, method)
     if p is None:
         return "–"
     mae = {r.method: r.mae for r in rows}
-    lower = "GDN" if mae["GraphDistNet"] < mae["ClearanceNet"] else "CN"
+    lower = "GDN" if mae[method] < mae["ClearanceNet"] else "CN"
     return f"{'< 1e-300' if p == 0 else format(p, '.1e')} ({lower} lower)"
 
 
-def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> str:
-    """Markdown of Table I: ours beside the paper's numbers (paper in the ``paper`` columns)."""
+def table1_markdown(
+    results: dict[str, tuple[list[Result], float | None]], weights_dir: Path = WEIGHTS_DIR
+) -> str:
+    """Markdown of Table I: ours beside the paper's numbers (paper in the ``paper`` columns);
+    the notes name each GraphDistNet row's network (its card in ``weights_dir``)."""
     head = (
         "| env | method | time (s) | paper | MAE (m) [/reach] | paper | p (GDN vs CN) | paper "
         "| AUC | paper | ACD [n] | paper |"
     )
     lines = [head, "|" + "---|" * 12]
-    for env, (rows, p) in results.items():
+    for env, (rows, _) in results.items():
         for r in rows:
-            pt, pm, pa, pc = PAPER[env].get(r.method, (None,) * 4)
-            learned = r.method == "GraphDistNet"
-            p_text = _p_text(p, rows) if learned else ""
+            pt, pm, pa, pc = PAPER[env].get(PAPER_ROW.get(r.method, r.method), (None,) * 4)
+            learned = r.method in PAPER_ROW
+            if r.score is None and learned:
+                lines.append(f"| {env} | {r.method} | not trained yet | {_num(pt, '.5g')} | "
+                             f"| {_num(pm, '.4f')} | | {_num(PAPER_P[env], '.0e')} | "
+                             f"| {_num(pa, '.4f')} | | {_num(pc, '.4f')} |")  # fmt: skip
+                continue
+            p_text = _p_text(r.method, rows) if learned else ""
             mae = (
                 "N/A"
                 if r.method.startswith("DiffCo")
@@ -275,7 +352,21 @@ def table1_markdown(results: dict[str, tuple[list[Result], float | None]]) -> st
                 f"| {_num(r.acd, '.4f')}{_se_text(r)} "
                 f"| {_num(pc, '.4f')} |"
             )
-    return "\n".join(lines) + "\n" + NOTES
+    return "\n".join(lines) + "\n" + NOTES + networks_notes(tuple(results), weights_dir)
+
+
+def networks_notes(envs: tuple[str, ...], weights_dir: Path = WEIGHTS_DIR) -> str:
+    """One line per GraphDistNet row: its network, loss and data, read from its card."""
+    from .models.weights import read_card
+
+    lines = ["", "GraphDistNet rows, from their weights' cards:", ""]
+    for env in envs:
+        for name, file in GRAPHDISTNET_FILES.items():
+            path = Path(weights_dir) / file.format(env=env)
+            what = network_line(read_card(path, "weights")) if path.exists() else (
+                "not trained yet (`gdnplan reproduce faithful --env " + env + "`)")  # fmt: skip
+            lines.append(f"- ({env}) {name}: {what}")
+    return "\n".join(lines) + "\n"
 
 
 def _se_text(r: Result) -> str:
@@ -302,11 +393,12 @@ def table1(
             log(f"env {env}: " + ", ".join(r.method for r in out[env][0]))
     finally:
         torch.set_num_threads(threads)
+    files = {"ClearanceNet": "clearancenet_{env}.safetensors", **GRAPHDISTNET_FILES}
     missing = [
         f"{name} {env}"
         for env in envs
-        for name, path in (("ClearanceNet", f"clearancenet_{env}"), ("GraphDistNet", env))
-        if not (Path(weights_dir) / f"{path}.safetensors").exists()
+        for name, file in files.items()
+        if not (Path(weights_dir) / file.format(env=env)).exists()
     ]
     return out, missing, used
 
@@ -376,7 +468,7 @@ def table1_figures(results: dict[str, tuple[list[Result], float | None]], out_di
         curves[env] = {
             r.method: (*roc_curve(-r.score, truth <= DEFAULT_MARGIN), r.auc)
             for r in rows
-            if r.method != "coal" and "w/ AL" not in r.method
+            if r.method != "coal" and "w/ AL" not in r.method and r.score is not None
         }
         points[env] = {
             r.method: (truth[:1000], r.score[:1000]) for r in rows if r.abs_error is not None

@@ -30,7 +30,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from scipy import stats
 
-from .data import DATA_DIR, SPLITS, Dataset, load, make_shard, split_dir
+from .data import DATA_DIR, SPLITS, Dataset, load, split_dir, split_samples
 from .distance import signed_distance, signed_distance_and_grad
 from .errors import InputError
 from .models import DistanceModel
@@ -120,14 +120,15 @@ def test_set(env: str, n: int = SPLITS["test"][1], root: Path | str = DATA_DIR) 
     """The first n samples of the held-out split of ``env`` (seed 1).
 
     Reads ``data/<env>/test`` when it holds at least n samples, otherwise labels them here with
-    :func:`gdnplan.data.make_shard` (the same samples, as the split is a pure function).
+    :func:`gdnplan.data.split_samples`, the routine ``gdnplan generate`` writes its shards with
+    (the same samples either way).
     """
     path = split_dir(env, "test", root)
     if path.is_dir() and any(path.glob("shard_*.npz")):
         ds = load(path, n)
         if len(ds) >= n:
             return ds
-    return make_shard(env, SPLITS["test"][0], 0, n)
+    return split_samples(env, SPLITS["test"][0], 0, n)
 
 
 def scene_groups(ds: Dataset) -> list[np.ndarray]:

@@ -41,3 +41,41 @@ def test_near_boundary_samples_lie_in_the_band_with_coal_labels(env):
         np.testing.assert_allclose(ds.grad[i], g[0], atol=1e-9)
     robot = ds.robot(0)
     assert robot.within_limits(ds.q).all()
+
+
+@pytest.mark.parametrize("env", ["a", "b"])  # fixed scene, one scene per sample
+def test_test_set_without_data_equals_the_generated_shards(tmp_path, monkeypatch, env):
+    """`evaluate.test_set` with no data/ and `gdnplan generate` give the same samples, in the
+    first shard and in later ones (blocks of 4 here: samples 0–3, 4–7, 8–9)."""
+    from gdnplan import metrics
+
+    monkeypatch.setattr(data.sampling, "SHARD_SIZE", 4)
+    root = tmp_path / "data"
+    drawn = metrics.test_set(env, 10, root=root)  # no data/: labelled here
+    data.generate(env, 10, seed=1, out_dir=data.split_dir(env, "test", root), workers=1)
+    read = metrics.test_set(env, 10, root=root)  # from the shards
+    assert len(read) == len(drawn) == 10
+    for f in data.FIELDS:
+        np.testing.assert_array_equal(getattr(drawn, f), getattr(read, f), err_msg=f)
+    # a later block differs from the first (not one stream restarted per shard)
+    assert not np.allclose(drawn.q[4:8], drawn.q[:4])
+    np.testing.assert_array_equal(drawn.scene_seed, 10**8 + np.arange(10))
+
+
+def test_split_samples_of_any_range_are_the_split_s():
+    """A range that starts and ends inside blocks is the same samples as the whole split."""
+    import gdnplan.data.sampling as sampling
+
+    whole = sampling.split_samples("c", 1, 0, 12)
+    old = sampling.SHARD_SIZE
+    try:
+        sampling.SHARD_SIZE = 5
+        blocks = sampling.split_samples("c", 1, 0, 12)
+        part = sampling.split_samples("c", 1, 3, 8)
+    finally:
+        sampling.SHARD_SIZE = old
+    np.testing.assert_array_equal(blocks.q[3:11], part.q)
+    np.testing.assert_array_equal(blocks.d[3:11], part.d)
+    assert not np.allclose(whole.q[5:10], blocks.q[5:10])  # the blocks are the sampling unit
+    with pytest.raises(gp.InputError):
+        sampling.split_samples("c", 1, 0, 0)

@@ -14,7 +14,7 @@ def _arrays(path):
 
 
 def test_generate_is_resumable_and_load_concatenates(tmp_path, monkeypatch):
-    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    monkeypatch.setattr(data.sampling, "SHARD_SIZE", 4)
     out = tmp_path / "b"
     data.generate("b", 10, seed=1, out_dir=out, workers=1)
     files = sorted(out.glob("shard_*.npz"))
@@ -43,7 +43,7 @@ def test_bad_inputs_raise(tmp_path):
 @pytest.mark.parametrize("sizes", [(3, 7), (4, 9), (1, 2, 8), (5, 5)])
 def test_resume_with_a_larger_n_equals_a_one_shot_run(tmp_path, monkeypatch, sizes):
     """generate n₁ then n₂ > n₁ into one folder = generate n₂ once (same shards, same samples)."""
-    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    monkeypatch.setattr(data.sampling, "SHARD_SIZE", 4)
     once, resumed = tmp_path / "once", tmp_path / "resumed"
     data.generate("a", sizes[-1], seed=2, out_dir=once, workers=1)
     for n in sizes:
@@ -58,7 +58,7 @@ def test_resume_with_a_larger_n_equals_a_one_shot_run(tmp_path, monkeypatch, siz
 
 
 def test_resume_keeps_complete_shards_and_remakes_the_short_last_one(tmp_path, monkeypatch):
-    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    monkeypatch.setattr(data.sampling, "SHARD_SIZE", 4)
     data.generate("a", 6, seed=0, out_dir=tmp_path, workers=1)  # shards of 4 and 2
     first, second = tmp_path / "shard_0000.npz", tmp_path / "shard_0001.npz"
     stamps = first.stat().st_mtime_ns, second.stat().st_mtime_ns
@@ -72,7 +72,7 @@ def test_resume_keeps_complete_shards_and_remakes_the_short_last_one(tmp_path, m
     [({"env": "c"}, "--env"), ({"seed": 1}, "--seed"), ({"near": 0.5}, "--near")],
 )
 def test_resume_with_other_settings_is_refused(tmp_path, monkeypatch, change, option):
-    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    monkeypatch.setattr(data.sampling, "SHARD_SIZE", 4)
     settings = {"env": "a", "seed": 0, "near": 0.0}
     data.generate(n=5, out_dir=tmp_path, workers=1, **settings)
     before = {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()}
@@ -82,7 +82,7 @@ def test_resume_with_other_settings_is_refused(tmp_path, monkeypatch, change, op
 
 
 def test_a_smaller_n_and_unrecorded_shards_are_refused(tmp_path, monkeypatch):
-    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    monkeypatch.setattr(data.sampling, "SHARD_SIZE", 4)
     data.generate("a", 9, seed=0, out_dir=tmp_path, workers=1)
     for n in (8, 5, 3):  # fewer shards, or a shorter last shard
         with pytest.raises(InputError, match=r"^--n: .*holds 9 samples.*n ≥ 9"):
@@ -97,7 +97,7 @@ def test_a_smaller_n_and_unrecorded_shards_are_refused(tmp_path, monkeypatch):
 
 
 def test_an_interrupted_shard_leaves_no_temp_and_is_made_on_resume(tmp_path, monkeypatch):
-    monkeypatch.setattr(data.shards, "SHARD_SIZE", 4)
+    monkeypatch.setattr(data.sampling, "SHARD_SIZE", 4)
     real = np.savez_compressed
 
     def interrupted(f, **arrays):

@@ -91,6 +91,22 @@ def test_reproduce_table1_fast_writes_markdown(tmp_path):
     assert res.exit_code == 0, res.output
     text = out.read_text()
     assert "| a | coal |" in text and "| a | DiffCo |" in text and "machine:" in text
+    assert "| a | GraphDistNet (gdnplan) | " in text  # beside the paper's row, named
+    faithful = "| a | GraphDistNet (paper architecture, this implementation) | "
+    trained = (ev.WEIGHTS_DIR / "a_faithful.safetensors").exists()
+    assert (faithful + "not trained yet |" in text) != trained and faithful in text
+    assert "- (a) GraphDistNet (gdnplan): soft nearest-node partners" in text  # its network
+
+
+def test_network_line_names_the_architecture_and_loss():
+    card = {
+        "config": {"cross": "argmax", "two_way": True},  # an old card: one pick per node
+        "training": {"loss": {"grad_weight": 0.1}, "seconds": 12.0},
+        "data": {"n_train": 36000, "extra": {}},
+    }
+    line = ev.network_line(card)
+    assert line.startswith("random (one per node), then argmax partners, two-way cross edges;")
+    assert "loss: distance + gradient λ = 0.1; 36 000 training samples; 12 s" in line
 
 
 def test_fig5_panels_and_detour_path_is_free():

@@ -410,3 +410,25 @@ def test_config_keeps_the_architecture_and_refuses_removed_options_at_other_valu
             GraphDistNetConfig.from_dict({key: value})
     with pytest.raises(gp.InputError, match="GraphDistNetLoss"):
         GraphDistNetConfig().with_(grad_weight=0.1)
+
+
+@pytest.mark.parametrize("pick", ["graph", "node"])
+def test_faithful_first_layer_picks_one_random_partner_per_graph(pick):
+    """§IV-A: "a single connection node per graph (j_{c,r}, j_{c,o})", randomly selected;
+    ``random_pick="node"`` (the weights trained before) draws one per node."""
+    scene = gp.make_scene("d", seed=2)
+    net = GraphDistNet(GraphDistNetConfig.faithful(random_pick=pick, scale=scene.robot.reach))
+    graph = robot_graph(scene.robot)
+    obstacles = obstacle_graph(*scene_obstacles([scene]), None)
+    nodes = torch.tensor(graph.positions_and_jacobians(scene.robot.sample(3, seed=0))[0])
+    g = net.union(graph.batch(nodes), _repeat(obstacles, 3))
+    idx = net.partners_argmax(g, None, 0, torch.Generator().manual_seed(1))
+    n_r = g.n_robot
+    assert idx.shape == g.mask.shape
+    assert (idx[:, :n_r] >= n_r).all() and (idx[:, n_r:] < n_r).all()  # the other graph
+    assert g.mask.gather(1, idx).all()  # real nodes only
+    distinct = [len(set(row[:n_r].tolist())) for row in idx] + [
+        len(set(row[n_r:][g.mask[i, n_r:]].tolist())) for i, row in enumerate(idx)
+    ]
+    assert max(distinct) == 1 if pick == "graph" else min(distinct) > 1
+    assert GraphDistNetConfig.from_dict({"cross": "argmax"}).random_pick == "node"  # old cards

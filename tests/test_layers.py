@@ -84,6 +84,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "env_models",
             "evaluate",
             "table2",
+            "ablation",
             "fetch",
             "arm3d.fetch3d",
             "arm3d.fetch3d_files",

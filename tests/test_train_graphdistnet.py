@@ -109,3 +109,14 @@ def test_the_old_call_still_trains_with_a_deprecation_warning(tiny_data):
 def test_bad_train_configs_name_the_field(changes, field):
     with pytest.raises(InputError, match=rf"^{field}: "):
         TrainConfig(**changes)
+
+
+def test_a_compiled_step_network_is_kept():
+    """``--compile``: the learner takes the torch.compile wrapper (whose truth value raises)."""
+    from gdnplan.models.graphdistnet import GraphDistNet
+    from gdnplan.train.graphdistnet import GraphDistNetLearner
+
+    net = GraphDistNet(GraphDistNetConfig.faithful())
+    compiled = torch.compile(net, dynamic=True)
+    assert GraphDistNetLearner(net, None, None, None, step_net=compiled).step_net is compiled
+    assert GraphDistNetLearner(net, None, None, None).step_net is net

@@ -103,7 +103,7 @@ def table1_command(
         "",
         "",
     ]
-    text = "\n".join(header) + ev.table1_markdown(results) + "\n"
+    text = "\n".join(header) + ev.table1_markdown(results, weights) + "\n"
     typer.echo(text)
     write_text(out, text, "--out")
     if figures is not None:
@@ -187,3 +187,83 @@ def field_command(
     check_output_path(out, FIGURE_SUFFIXES, "--out")
     save_figure(fig5(env, grid, progress=not quiet), out)
     typer.echo(f"wrote {out}")
+
+
+@reproduce_app.command("ablation")
+def ablation_command(
+    fast: bool = typer.Option(False, "--fast", help="Tiny data, one epoch (CI; not a result)."),
+    envs: str = typer.Option("b,d,e", help="Environments (comma-separated)."),
+    seeds: int = typer.Option(2, min=1, help="Training seeds per step."),
+    budget: float = typer.Option(1200.0, help="Training seconds per step and seed (> 0)."),
+    data: Path = typer.Option(None, help="Data root (default data/; --fast: a temporary one)."),
+    runs: Path = typer.Option(Path("runs/ablation"), help="Trained steps (kept, skipped)."),
+    out: Path = typer.Option(Path("results/ablation.md"), help="Markdown output."),
+) -> None:
+    """Faithful → soft partners → one-way → node distances → soft-minimum readout → probe
+    points → band readout, one change a step, same data, budget and seeds (resumable)."""
+    import datetime
+    import tempfile
+
+    from .. import ablation
+    from ..data import DATA_DIR, generate, split_dir
+
+    check_output_path(out, (".md",), "--out")
+    chosen = tuple(e.strip() for e in envs.split(",") if e.strip())
+    if not chosen or any(e not in ablation.BEST for e in chosen):
+        raise InputError(f"--envs: expected some of {sorted(ablation.BEST)}, got {envs!r}")
+    if not budget > 0:
+        raise InputError(f"--budget: expected a positive number of seconds, got {budget}")
+    set_threads(1, torch_global=True)
+    s = ablation.Settings.fast() if fast else ablation.Settings(budget=budget)
+    with tempfile.TemporaryDirectory() as tmp:
+        root = data or (Path(tmp) / "data" if fast else DATA_DIR)
+        if fast:
+            runs = Path(tmp) / "runs"
+            for env in chosen:
+                for split, seed, n in (("train", 0, 40), ("test", 1, 24)):
+                    target = split_dir(env, split, root)
+                    if not target.exists():
+                        generate(env, n, seed, target, workers=1)
+        results = ablation.run(chosen, seeds, s, root, runs, log=lambda m: typer.echo(m, err=True))
+    command = (
+        f"gdnplan reproduce ablation{' --fast' if fast else ''} --envs {','.join(chosen)} "
+        f"--seeds {seeds}" + ("" if fast else f" --budget {budget:g}")
+    )
+    text = "\n".join([
+        "# Ablation: the paper's GraphDistNet to gdnplan's, one change a step"
+        + (" (fast mode: tiny data, not a result)" if fast else ""),
+        "",
+        f"- command: `{command}`",
+        f"- date: {datetime.datetime.now().isoformat(timespec='seconds')}",
+        "",
+        ablation.markdown(results, s),
+    ])  # fmt: skip
+    typer.echo(text)
+    write_text(out, text, "--out")
+
+
+@reproduce_app.command("faithful")
+def faithful_command(
+    env: str = typer.Option(..., help="Environment a-e (its data must exist, as for train)."),
+    data: Path = typer.Option(None, help="Data root (default data/)."),
+    budget: float = typer.Option(None, help="Training seconds (default: the shipped weights')."),
+    out: Path = typer.Option(None, help="Weights (default weights/<env>_faithful.safetensors)."),
+    threads: int = typer.Option(1, help=THREADS_HELP),
+) -> None:
+    """Train the paper's GraphDistNet (§IV) for Table I on the data and time budget of the
+    environment's shipped weights; rerun the same command to resume (runs/faithful/<env>)."""
+    from .. import ablation
+    from ..assets import WEIGHTS_DIR
+    from ..train import train
+
+    if env not in ablation.BEST:
+        raise InputError(f"--env: expected one of {sorted(ablation.BEST)}, got {env!r}")
+    if budget is not None and not budget > 0:
+        raise InputError(f"--budget: expected a positive number of seconds, got {budget}")
+    out = out or WEIGHTS_DIR / f"{env}_faithful.safetensors"
+    check_output_path(out, (".safetensors",), "--out")
+    set_threads(threads, torch_global=True)
+    config = ablation.faithful_config(env, data or Path("data"), budget)
+    card = train(env, config, "faithful", data_root=data or Path("data"), out=out,
+                 run_dir=Path("runs/faithful") / env)  # fmt: skip
+    typer.echo(f"wrote {out}: test {card['test']}")

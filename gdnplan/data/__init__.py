@@ -26,8 +26,15 @@ from .dataset import (
     split_dir,
     variant_robot,
 )
-from .sampling import BOUNDARY_BAND, RANDOM_ENVS, make_shard, near_boundary
-from .shards import MANIFEST, MANIFEST_OPTIONS, SHARD_SIZE, generate, shard_paths
+from .sampling import (
+    BOUNDARY_BAND,
+    RANDOM_ENVS,
+    SHARD_SIZE,
+    make_shard,
+    near_boundary,
+    split_samples,
+)
+from .shards import MANIFEST, MANIFEST_OPTIONS, generate, shard_paths
 from .ur5e_samples import (
     CANONICAL_SHARE,
     FETCH_SEED_BASE,
@@ -71,6 +78,7 @@ __all__ = [
     "random_boxes",
     "shard_paths",
     "split_dir",
+    "split_samples",
     "ur5e_layout_seeds",
     "variant_robot",
 ]

@@ -14,6 +14,12 @@ For the environments a–e, ``near`` > 0 concentrates that fraction of the sampl
 collision boundary (beyond the paper, for AUC and gradients where they matter): a
 near-boundary sample is q uniform within the limits conditioned on |f(q)| < ``BOUNDARY_BAND``,
 drawn by rejection (uniform candidates labelled by coal, the first ones inside the band kept).
+
+A split is drawn in blocks of ``SHARD_SIZE`` samples: block b is ``make_shard(env, seed,
+b · SHARD_SIZE, SHARD_SIZE)``, the shard ``gdnplan generate`` writes as ``shard_<b>.npz``.
+:func:`split_samples` is the one routine that makes any range of a split from those blocks,
+for :func:`gdnplan.data.generate` (its shards) and for :func:`gdnplan.metrics.test_set`
+(without ``data/``), so both give the same samples.
 """
 
 from __future__ import annotations
@@ -24,10 +30,11 @@ from ..distance import signed_distance, signed_distance_and_grad
 from ..errors import InputError
 from ..geometry import pad_polygons
 from ..scene import Scene, make_scene
-from .dataset import Dataset
+from .dataset import Dataset, concat
 from .ur5e_samples import make_ur5e_shard
 
 RANDOM_ENVS = ("b", "d", "e")
+SHARD_SIZE = 2500  # samples per block of a split (one shard of gdnplan generate)
 BOUNDARY_BAND = 0.03  # m: near-boundary samples of a–e have |f| below this
 
 
@@ -75,3 +82,29 @@ def make_shard(env: str, seed: int, start: int, n: int, near: float = 0.0) -> Da
     obstacles, sizes = pad_polygons(polys)
     nodes = robot.node_positions(q).astype(np.float32)
     return Dataset(env, q, nodes, obstacles, sizes, d, grad, scene_seed)
+
+
+def _prefix_consistent(env: str, near: float) -> bool:
+    """True when ``make_shard(env, seed, start, k)`` is the first k samples of any longer
+    shard at ``start``: uniform a–e samples (one uniform stream seeded (seed, start), scene
+    seeds by index). Near-boundary and ``ur5e`` shards draw per-shard streams of length n."""
+    return env != "ur5e" and near == 0.0
+
+
+def split_samples(env: str, seed: int, start: int, n: int, near: float = 0.0) -> Dataset:
+    """Samples ``start … start + n − 1`` of the split of ``env`` with ``seed``, block by block
+    (module docstring): the samples of ``gdnplan generate``'s shards, whatever the range.
+
+    Each block b overlapping the range is ``make_shard(env, seed, b · SHARD_SIZE, k)``, k
+    the samples of it up to the range's end (or the whole block where a shorter shard is not
+    its prefix, :func:`_prefix_consistent`), with the samples before ``start`` dropped.
+    """
+    if n < 1 or start < 0:
+        raise InputError(f"n: expected n ≥ 1 samples from start ≥ 0, got n = {n}, start = {start}")
+    size, end = SHARD_SIZE, start + n
+    parts = []
+    for block in range(start // size * size, end, size):
+        stop = min(end, block + size) - block  # the range's end within the block
+        part = make_shard(env, seed, block, stop if _prefix_consistent(env, near) else size, near)
+        parts.append(part.subset(slice(max(start - block, 0), stop)))
+    return parts[0] if len(parts) == 1 else concat(parts)

@@ -1,7 +1,8 @@
 """Writing a split as resumable ``.npz`` shards (:func:`generate`).
 
-Shards of ``SHARD_SIZE`` samples are written by a pool of processes, each to a temporary file
-renamed when complete (:func:`gdnplan.files.atomic_path`).
+Shards of ``SHARD_SIZE`` samples (the blocks of :func:`.sampling.split_samples`, the routine
+:func:`gdnplan.metrics.test_set` draws from too) are written by a pool of processes, each to a
+temporary file renamed when complete (:func:`gdnplan.files.atomic_path`).
 
 Resuming: the folder's ``manifest.json`` records the settings of its split (env, seed, near,
 shard size), written before the first shard. Running :func:`generate` again with the same
@@ -25,24 +26,23 @@ from tqdm import tqdm
 
 from ..errors import InputError, UnknownNameError
 from ..files import write_text
+from . import sampling
 from .dataset import ENVS
-from .sampling import make_shard
-
-SHARD_SIZE = 2500
+from .sampling import SHARD_SIZE as SHARD_SIZE  # re-exported; read as sampling.SHARD_SIZE
 
 
 def _write_shard(job: tuple[str, int, int, int, str, float]) -> int:
     env, seed, start, n, path, near = job
-    make_shard(env, seed, start, n, near).save(path)
+    sampling.split_samples(env, seed, start, n, near).save(path)
     return n
 
 
 def shard_paths(out_dir: Path | str, n: int) -> list[tuple[int, int, Path]]:
     """(start, size, path) of every shard of an n-sample split in ``out_dir``."""
-    out_dir = Path(out_dir)
+    out_dir, size = Path(out_dir), sampling.SHARD_SIZE
     return [
-        (start, min(SHARD_SIZE, n - start), out_dir / f"shard_{start // SHARD_SIZE:04d}.npz")
-        for start in range(0, n, SHARD_SIZE)
+        (start, min(size, n - start), out_dir / f"shard_{start // size:04d}.npz")
+        for start in range(0, n, size)
     ]
 
 
@@ -132,7 +132,8 @@ def generate(
         raise InputError(f"near: expected a fraction in [0, 1], got {near}")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    settings = {"env": env, "seed": int(seed), "near": float(near), "shard_size": SHARD_SIZE}
+    size = sampling.SHARD_SIZE
+    settings = {"env": env, "seed": int(seed), "near": float(near), "shard_size": size}
     _check_manifest(out_dir, settings)
     jobs = [(env, seed, s, k, str(p), near) for s, k, p in _missing_shards(out_dir, n)]
     done = n - sum(j[3] for j in jobs)

@@ -19,8 +19,9 @@ def save_checkpoint(path: Path, net: torch.nn.Module, opt: torch.optim.Adam, sta
     """Write ``net``'s tensors (``net.*``), Adam's state (``opt.<i>.*``), the best state
     (``best.*``) and the rest of ``state`` (the JSON card) to ``path``."""
     tensors = {f"net.{k}": v for k, v in net.state_dict().items()}
-    for i, s in enumerate(opt.state.values()):
-        for k, v in s.items():
+    params = [p for g in opt.param_groups for p in g["params"]]
+    for i, p in enumerate(params):  # by parameter index: unused parameters have no state
+        for k, v in opt.state.get(p, {}).items():
             tensors[f"opt.{i}.{k}"] = torch.as_tensor(v)
     best = state.pop("best_state", None)
     if best is not None:

@@ -157,7 +157,7 @@ class GraphDistNetLearner:
     ):
         self.net, self.train_t, self.val_t = net, train_t, val_t
         self.weights, self.device = weights, device
-        self.step_net = step_net or net
+        self.step_net = net if step_net is None else step_net  # a compiled module refuses len()
 
     def __len__(self) -> int:
         return len(self.train_t)

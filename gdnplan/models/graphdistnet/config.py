@@ -29,6 +29,11 @@ class GraphDistNetConfig:
         readout: hidden widths of the final MLP.
         cross: ``"argmax"`` (paper: random, then argmax partner) or ``"soft_knn"``.
         cross_k: candidates k of ``soft_knn`` (k + 1 nearest nodes are looked at).
+        random_pick: the first-layer partners of ``argmax``: ``"graph"`` (the paper: one
+            random node j_c per graph, the partner of every node of the other graph, §IV-A
+            "a single connection node per graph (j_{c,r}, j_{c,o})") or ``"node"`` (a random
+            partner per node: the weights trained before the paper's reading was fixed, whose
+            cards lack the field; ``from_dict`` loads them so).
         two_way: cross edges into both graphs (the paper). False: only robot nodes take a
             cross partner (obstacle nodes have z̄_i = z_i), so the obstacle features depend on
             the scene alone and inference computes them once per scene (package docstring).
@@ -58,6 +63,7 @@ class GraphDistNetConfig:
     readout: tuple[int, ...] = (32, 32, 32)
     cross: str = "soft_knn"
     cross_k: int = 4
+    random_pick: str = "graph"
     two_way: bool = True
     tau: float = 0.02
     node_distance: bool = False
@@ -75,6 +81,8 @@ class GraphDistNetConfig:
                 raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
         if self.cross not in ("argmax", "soft_knn"):
             raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
+        if self.random_pick not in ("graph", "node"):
+            raise InputError(f"random_pick: expected 'graph' or 'node', got {self.random_pick!r}")
         if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
             raise InputError("layers, hidden, cross_k and scale must be positive")
         if self.min_readout and not self.node_distance:
@@ -88,7 +96,8 @@ class GraphDistNetConfig:
 
     @classmethod
     def faithful(cls, **changes) -> GraphDistNetConfig:
-        """The paper's network: random/argmax partners, LeakyReLU."""
+        """The paper's network (§IV): one random, then the argmax partner per graph, two-way
+        cross edges, no node distances, the plain readout, LeakyReLU."""
         return cls(cross="argmax", **changes)
 
     @classmethod
@@ -111,6 +120,8 @@ class GraphDistNetConfig:
                     f"config: {key} = {value!r}: the option was removed (only its former "
                     f"default {default!r} is accepted); drop it from the config or retrain"
                 )
+        if data.get("cross") == "argmax":  # cards before random_pick drew a partner per node
+            data.setdefault("random_pick", "node")
         known = {f.name for f in fields(cls)}
         unknown = set(data) - known
         if unknown:

@@ -1,0 +1,284 @@
+"""From the paper's GraphDistNet to gdnplan's, one change a step (issue #25).
+
+:data:`STEPS` starts at the paper's network (§IV, :meth:`GraphDistNetConfig.faithful`) and
+each step changes one architecture field of the step before; every step is trained with the
+same data, time budget, seeds and loss (the paper's: the squared distance error, no gradient
+or contact terms) and scored on the same held-out samples:
+
+* MAE (m), AUC and ACD on the test split (the card's, :func:`gdnplan.train.report.evaluate`),
+  the mean over training seeds ± its standard error s / √S (S ≥ 2 seeds);
+* time of d̂ and ∂d̂/∂q per configuration (s), one batch of ``batch`` configurations in one
+  scene, fastest of 3, one torch thread;
+* sweep continuity: the largest |d̂(q + 0.003 e_j) − d̂(q)| (m) along 200-step sweeps of every
+  joint from ``sweeps`` random configurations (scene seed 11);
+* Table II: Ipopt's certified success and median wall time on the reaching problems of the
+  environment's setting (b, d; :func:`gdnplan.table2.reaching_problems`), when asked for.
+
+:func:`faithful_config` is the faithful network's run for Table I: the data and the time
+budget of the shipped (best) weights of the environment, :data:`BEST` (their cards).
+Every trained step is kept (``runs/ablation/<env>/<step>-s<seed>.safetensors`` + card, its
+scores in ``….scores.json``) and skipped when present; an interrupted training resumes from its
+checkpoint.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .data import DATA_DIR, split_dir
+from .models.graphdistnet import GraphDistNetConfig
+from .train import FitConfig, GraphDistNetLoss, TrainConfig
+
+__all__ = [
+    "BEST",
+    "ENVS",
+    "STEPS",
+    "Best",
+    "Settings",
+    "faithful_config",
+    "grad_time",
+    "markdown",
+    "run",
+    "score",
+    "step_config",
+    "sweep_max",
+    "table2_ipopt",
+    "train_step",
+]
+
+# (name, what changes, the one field changed), cumulative from the paper's network.
+STEPS: tuple[tuple[str, str, dict], ...] = (
+    ("faithful", "the paper (§IV): random, then argmax partner per graph, two-way", {}),
+    ("soft-partners", "soft nearest-node partners instead of argmax", {"cross": "soft_knn"}),
+    ("one-way", "cross edges into the robot graph only", {"two_way": False}),
+    ("node-distances", "every node's signed distance to the other graph", {"node_distance": True}),
+    ("soft-min", "d̂ = soft minimum of node distances + MLP", {"min_readout": True}),
+    ("probe-points", "the soft minimum also over 4 points per edge", {"probe_split": 5}),
+    ("band", "d̂ = the soft minimum beyond ≈ 2 cm of contact", {"correction_band": 0.01}),
+)
+ENVS = ("b", "d", "e")
+TABLE2_SETTINGS = ("b", "d")  # environments with a Table II setting of their own
+
+
+@dataclass(frozen=True)
+class Best:
+    """Data and training seconds of an environment's shipped weights (weights/<env>.json and
+    its lineage: the sum of every training step from scratch)."""
+
+    seconds: float
+    n_train: int | None  # first samples of data/<env>/train (None: all 50 000)
+    near: bool  # + the 20 000 near-boundary samples of data/near/<env>/train (seed 3)
+    compile: bool  # their runs used torch.compile (the cards: d and e)
+
+
+BEST = {
+    "a": Best(2242 + 1560 + 1250, None, True, False),
+    "b": Best(447 + 3075, None, False, False),
+    "c": Best(1569 + 1608 + 792, None, True, False),
+    "d": Best(1520 + 2767, None, False, True),
+    "e": Best(1522 + 3051, 45_000, False, True),
+}
+
+
+def step_config(step: int) -> GraphDistNetConfig:
+    """The network of ``STEPS[step]``: the faithful one with every change up to it."""
+    changes: dict = {}
+    for _, _, change in STEPS[: step + 1]:
+        changes |= change
+    return GraphDistNetConfig.faithful().with_(**changes)
+
+
+def _extra(env: str, data_root: Path | str) -> tuple[str, ...]:
+    return (str(Path(data_root) / "near" / env / "train"),) if BEST[env].near else ()
+
+
+def faithful_config(
+    env: str, data_root: Path | str = DATA_DIR, budget: float | None = None
+) -> TrainConfig:
+    """The paper's network and loss on the data and time budget of ``env``'s shipped weights
+    (:data:`BEST`; ``budget`` overrides the seconds), patience 40, no epoch cap below 1000."""
+    best = BEST[env]
+    fit = FitConfig(epochs=1000, patience=40, time_budget=budget or best.seconds)
+    return TrainConfig(
+        GraphDistNetConfig.faithful(),
+        GraphDistNetLoss(),
+        fit,
+        best.n_train,
+        _extra(env, data_root),
+        compile=best.compile,
+    )
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Sizes of one ablation run (:meth:`fast` for CI)."""
+
+    budget: float = 1200.0  # training seconds per step and seed
+    epochs: int = 1000
+    batch: int = 256
+    sweeps: int = 3  # random start configurations of the joint sweeps
+    sweep_steps: int = 200
+    timing_batch: int = 256
+    table2: int = 20  # reaching problems (0: no Table II column)
+
+    @classmethod
+    def fast(cls) -> Settings:
+        return cls(budget=30.0, epochs=1, batch=16, sweeps=1, sweep_steps=20, timing_batch=16,
+                   table2=0)  # fmt: skip
+
+
+def sweep_max(model, scene, sweeps: int = 3, steps: int = 200) -> float:
+    """Largest |Δd̂| (m) between consecutive 0.003 rad steps of sweeps of every joint."""
+    robot = scene.robot
+    worst = 0.0
+    for q0 in robot.sample(sweeps, seed=7):
+        for j in range(robot.dof):
+            q = np.repeat(q0[None], steps, 0)
+            q[:, j] = np.clip(
+                q0[j] - 0.3 + 0.003 * np.arange(steps), robot.lower[j], robot.upper[j]
+            )
+            worst = max(worst, float(np.abs(np.diff(model.distance(scene, q))).max()))
+    return worst
+
+
+def grad_time(model, scene, batch: int) -> float:
+    """Seconds per configuration of d̂ and ∂d̂/∂q over one batch (fastest of 3)."""
+    q = scene.robot.sample(batch, seed=3)
+    model.distance_and_grad(scene, q[:2])  # scene cache, warm-up
+    best = np.inf
+    for _ in range(3):
+        start = time.perf_counter()
+        model.distance_and_grad(scene, q)
+        best = min(best, time.perf_counter() - start)
+    return best / batch
+
+
+def table2_ipopt(model, setting: str, n: int) -> tuple[int, float]:
+    """(certified successes, median wall time s) of Ipopt with ``model`` on Table II's
+    ``setting`` problems 0 … n − 1."""
+    from .table2 import reaching_problems
+    from .trajopt import PlanConfig, plan
+    from .trajopt.config import with_optimizer
+
+    config = with_optimizer(PlanConfig(), "ipopt")
+    runs = [plan(p, collision=model, solver=config, seed=i)
+            for i, p in enumerate(reaching_problems(setting, n))]  # fmt: skip
+    return sum(bool(r.success) for r in runs), float(np.median([r.solve_time for r in runs]))
+
+
+def score(weights: Path, env: str, s: Settings) -> dict:
+    """The ablation's columns of one trained step (module docstring)."""
+    from .models import load_model
+    from .scene import make_scene
+
+    model = load_model(weights, threads=1)
+    card = json.loads(weights.with_suffix(".json").read_text())
+    test, scene = card["test"], make_scene(env, seed=11)
+    out = {
+        "mae": test["mae_m"], "auc": test["auc"], "acd": test["acd"], "n_test": test["n"],
+        "seconds": card["training"]["seconds"], "epochs": card["training"]["epochs"],
+        "grad_time": grad_time(model, scene, s.timing_batch),
+        "sweep_max": sweep_max(model, scene, s.sweeps, s.sweep_steps),
+    }  # fmt: skip
+    if s.table2 and env in TABLE2_SETTINGS:
+        out["t2_success"], out["t2_median"] = table2_ipopt(model, env, s.table2)
+        out["t2_n"] = s.table2
+    return out
+
+
+def train_step(env: str, step: int, seed: int, s: Settings, data_root: Path, runs: Path) -> Path:
+    """Train ``STEPS[step]`` with ``seed`` (skipped when its weights exist); their path."""
+    from .train import train
+
+    name = f"{STEPS[step][0]}-s{seed}"
+    out = runs / env / f"{name}.safetensors"
+    if out.exists():
+        return out
+    best = BEST[env]
+    fit = FitConfig(batch=s.batch, epochs=s.epochs, patience=40, time_budget=s.budget, seed=seed)
+    config = TrainConfig(step_config(step), GraphDistNetLoss(), fit, best.n_train,
+                         _extra(env, data_root))  # fmt: skip
+    train(env, config, name, data_root=data_root, out=out, run_dir=runs / env / name)
+    return out
+
+
+def run(
+    envs: tuple[str, ...] = ENVS,
+    seeds: int = 2,
+    s: Settings | None = None,
+    data_root: Path | str = DATA_DIR,
+    runs: Path | str = Path("runs/ablation"),
+    log: Callable[[str], None] = print,
+) -> dict[str, list[list[dict]]]:
+    """{env: [[scores of each seed] for each step]}, training and scoring what is missing."""
+    s = s or Settings()
+    data_root, runs = Path(data_root), Path(runs)
+    out: dict[str, list[list[dict]]] = {}
+    for env in envs:
+        if not split_dir(env, "train", data_root).is_dir():
+            raise FileNotFoundError(f"{split_dir(env, 'train', data_root)}: generate it first")
+        out[env] = []
+        for step in range(len(STEPS)):
+            per_seed = []
+            for seed in range(seeds):
+                weights = train_step(env, step, seed, s, data_root, runs)
+                cached = weights.with_suffix(".scores.json")
+                if not cached.exists():
+                    cached.write_text(json.dumps(score(weights, env, s), indent=1) + "\n")
+                per_seed.append(json.loads(cached.read_text()))
+                log(f"ablation {env} {STEPS[step][0]} seed {seed}: {per_seed[-1]}")
+            out[env].append(per_seed)
+    return out
+
+
+def _mean_se(values: list[float], fmt: str) -> str:
+    v = np.asarray(values, float)
+    if len(v) < 2:
+        return format(v.mean(), fmt)
+    return f"{format(v.mean(), fmt)} ± {format(v.std(ddof=1) / np.sqrt(len(v)), fmt)}"
+
+
+def markdown(results: dict[str, list[list[dict]]], s: Settings) -> str:
+    """The ablation table (one row per environment and step) and its notes."""
+    head = ("| env | step | change | MAE (mm) | AUC | ACD | d̂+∇ (ms/config) | sweep max (cm) "
+            "| Table II Ipopt | median (s) | train s (epochs) |")  # fmt: skip
+    lines = [head, "|" + "---|" * 11]
+    for env, steps in results.items():
+        for (name, change, _), runs in zip(STEPS, steps, strict=True):
+            t2 = "–", "–"
+            if all("t2_success" in r for r in runs):
+                ok, n = sum(r["t2_success"] for r in runs), sum(r["t2_n"] for r in runs)
+                t2 = f"{ok}/{n}", f"{np.median([r['t2_median'] for r in runs]):.2f}"
+            lines.append(
+                f"| {env} | {name} | {change} | {_mean_se([1e3 * r['mae'] for r in runs], '.2f')} "
+                f"| {_mean_se([r['auc'] for r in runs], '.4f')} "
+                f"| {_mean_se([r['acd'] for r in runs], '.3f')} "
+                f"| {1e3 * np.mean([r['grad_time'] for r in runs]):.3f} "
+                f"| {100 * max(r['sweep_max'] for r in runs):.2f} | {t2[0]} | {t2[1]} "
+                f"| {np.mean([r['seconds'] for r in runs]):.0f} "
+                f"({'/'.join(str(r['epochs']) for r in runs)}) |"
+            )
+    n_test = sorted({r["n_test"] for steps in results.values() for runs in steps for r in runs})
+    return "\n".join(lines) + "\n" + notes(s, "/".join(map(str, n_test)))
+
+
+def notes(s: Settings, n_test: str) -> str:
+    return f"""
+Notes: each step changes one field of the step above (`gdnplan.ablation.STEPS`). Every step
+is trained from scratch on the same data (`data/<env>/train`, the shipped weights' share of
+it) for the same {s.budget:g} s of training (the epochs' own time on this shared CPU; early
+stopping after 40 epochs without a better validation MAE), with the paper's loss (squared
+distance error only) and the same seeds; ± is the standard error over the seeds. MAE, AUC,
+ACD: the {n_test} samples of `data/<env>/test` (seed 1). d̂+∇: one batch of
+{s.timing_batch} configurations of one scene, fastest of 3, one thread. Sweep max: the
+largest change of d̂ between 0.003 rad steps along {s.sweep_steps}-step sweeps of every joint
+from {s.sweeps} configuration(s), the largest over the seeds. Table II: Ipopt on the
+environment's own reaching problems (b and d only), certified successes over all seeds and
+the median wall time.
+"""

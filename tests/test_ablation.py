@@ -1,0 +1,65 @@
+"""The ablation (gdnplan.ablation): one change a step, resumable, and its --fast CLI run."""
+
+from dataclasses import fields
+
+import pytest
+from typer.testing import CliRunner
+
+import gdnplan.train as training
+from gdnplan import ablation, data
+from gdnplan.cli import app
+from gdnplan.models.graphdistnet import GraphDistNetConfig
+
+
+def test_each_step_changes_one_field_of_the_step_before():
+    assert ablation.step_config(0) == GraphDistNetConfig.faithful()
+    assert ablation.step_config(0).cross == "argmax" and ablation.step_config(0).two_way
+    for step in range(1, len(ablation.STEPS)):
+        before, after = ablation.step_config(step - 1), ablation.step_config(step)
+        changed = [
+            f.name for f in fields(after) if getattr(before, f.name) != getattr(after, f.name)
+        ]
+        assert changed == list(ablation.STEPS[step][2]), ablation.STEPS[step][0]
+
+
+def test_faithful_run_has_the_shipped_weights_data_and_budget():
+    c = ablation.faithful_config("a", "data")
+    assert c.network == GraphDistNetConfig.faithful() and c.loss == training.GraphDistNetLoss()
+    assert c.fit.time_budget == 2242 + 1560 + 1250 and c.extra == ("data/near/a/train",)
+    assert ablation.faithful_config("e").n_train == 45_000
+    assert ablation.faithful_config("d", budget=10).fit.time_budget == 10
+
+
+@pytest.mark.slow  # seven trainings; the --fast CLI test below runs them in the default suite
+def test_trained_steps_are_kept_and_skipped(tmp_path, monkeypatch):
+    root = tmp_path / "data"
+    data.generate("b", 24, 0, data.split_dir("b", "train", root), workers=1)
+    data.generate("b", 12, 1, data.split_dir("b", "test", root), workers=1)
+    s = ablation.Settings.fast()
+    first = ablation.run(("b",), 1, s, root, tmp_path / "runs", log=lambda m: None)
+    assert len(first["b"]) == len(ablation.STEPS) and first["b"][0][0]["n_test"] == 12
+    assert len(list((tmp_path / "runs" / "b").glob("*.safetensors"))) == len(ablation.STEPS)
+
+    def no_training(*args, **kwargs):
+        raise AssertionError("a kept step was trained again")
+
+    monkeypatch.setattr(training, "train", no_training)
+    assert ablation.run(("b",), 1, s, root, tmp_path / "runs", log=lambda m: None) == first
+    text = ablation.markdown(first, s)
+    assert text.count("\n| b |") == len(ablation.STEPS) and "12 samples" in text
+
+
+def test_fast_cli_writes_the_table_and_refuses_bad_input(tmp_path):
+    out = tmp_path / "ablation.md"
+    args = ["reproduce", "ablation", "--fast", "--envs", "b", "--seeds", "1", "--out", str(out)]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "fast mode" in out.read_text() and out.read_text().count("\n| b |") == 7
+    bad = CliRunner().invoke(app, ["reproduce", "ablation", "--fast", "--envs", "z"])
+    assert bad.exit_code != 0 and "--envs" in str(bad.exception)
+
+
+@pytest.mark.parametrize("env", ["z"])
+def test_faithful_cli_refuses_an_unknown_env(env):
+    result = CliRunner().invoke(app, ["reproduce", "faithful", "--env", env])
+    assert result.exit_code != 0 and "--env" in str(result.exception)
