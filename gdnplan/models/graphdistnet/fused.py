@@ -24,6 +24,10 @@ first use and cached on disk (``cache=True``); :data:`AVAILABLE` is False withou
 
 from __future__ import annotations
 
+import contextlib
+import functools
+from collections.abc import Iterator
+
 import numpy as np
 import torch
 
@@ -31,6 +35,8 @@ from .layers import LEAKY_SLOPE
 
 try:
     import numba
+    import scipy.linalg.cython_blas  # noqa: F401  numba's numpy.dot calls this BLAS
+    from threadpoolctl import ThreadpoolController
 except ImportError:  # the reference path serves (GraphDistNetModel's default)
     numba = None
 
@@ -38,13 +44,35 @@ AVAILABLE = numba is not None
 TILE_ROWS = 4096  # edge rows per tile (3 N per configuration): 512 kB per buffer, in L2
 # (larger tiles keep sgemm efficient; docs/decisions.md#fused-inference)
 
-__all__ = ["AVAILABLE", "TILE_ROWS", "FusedRingMessages", "supports"]
+__all__ = ["AVAILABLE", "TILE_ROWS", "FusedRingMessages", "SparseMix", "supports"]
 
 
 def supports(mlp: tuple[int, ...]) -> bool:
     """Whether the fused kernel serves edge MLPs of hidden widths ``mlp`` (h_k's ``mlp``):
     at least two hidden widths (one hidden linear layer), all equal."""
     return AVAILABLE and len(mlp) >= 2 and len(set(mlp)) == 1
+
+
+@functools.cache
+def _blas_libraries() -> list:
+    """threadpoolctl's controllers of the loaded BLAS libraries (scipy's: numba's dot)."""
+    return ThreadpoolController().select(user_api="blas").lib_controllers
+
+
+@contextlib.contextmanager
+def _serial_blas() -> Iterator[None]:
+    """The BLAS libraries on one thread inside: the kernels' products are small (one tile),
+    and a BLAS thread pool waiting on a busy core costs far more than it gains
+    (docs/decisions.md#fused-inference); the caller's counts are restored after."""
+    libraries = _blas_libraries()
+    counts = [lib.num_threads for lib in libraries]
+    for lib in libraries:
+        lib.set_num_threads(1)
+    try:
+        yield
+    finally:
+        for lib, count in zip(libraries, counts, strict=True):
+            lib.set_num_threads(count)
 
 
 def _tile(n: int) -> int:
@@ -148,6 +176,62 @@ if AVAILABLE:
                         du[bb, jn, o] += gn
 
 
+if AVAILABLE:
+
+    @_jit
+    def _mix_forward(w, idx, v, out):
+        """out[b, i] ← Σ_c w[b, i, c] v[idx[b, i, c]] (w, idx (B, n, C); v (M, H))."""
+        bsz, n, cand = w.shape
+        h = v.shape[1]
+        for b in range(bsz):
+            for i in range(n):
+                for o in range(h):
+                    out[b, i, o] = 0
+                for k in range(cand):
+                    wk = w[b, i, k]
+                    j = idx[b, i, k]
+                    for o in range(h):
+                        out[b, i, o] += wk * v[j, o]
+
+    @_jit
+    def _mix_backward(grad, idx, v, dw):
+        """dw[b, i, c] ← grad[b, i] · v[idx[b, i, c]]."""
+        bsz, n, cand = idx.shape
+        h = v.shape[1]
+        for b in range(bsz):
+            for i in range(n):
+                for k in range(cand):
+                    j = idx[b, i, k]
+                    acc = grad[b, i, 0] * v[j, 0]
+                    for o in range(1, h):
+                        acc += grad[b, i, o] * v[j, o]
+                    dw[b, i, k] = acc
+
+
+class SparseMix(torch.autograd.Function):
+    """v̄_i = Σ_c w_ic v_{j_c} (B, n, H) for weights w (B, n, C), candidates idx (B, n, C)
+    (rows of v) and constant partner terms v (M, H) (one-way networks: the scene's obstacle
+    features): the cross terms without the dense (B, n, M) weights of
+    :func:`~.lean._cross_mix`. Gradients flow to w only: ∂w_ic = ∂v̄_i · v_{j_c}."""
+
+    @staticmethod
+    def forward(ctx, w: torch.Tensor, idx: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+        w_np = w.detach().contiguous().numpy()
+        idx_np = idx.contiguous().numpy()
+        v_np = v.detach().contiguous().numpy()
+        out = np.empty((*w_np.shape[:2], v_np.shape[1]), w_np.dtype)
+        _mix_forward(w_np, idx_np, v_np, out)
+        ctx.mix = (idx_np, v_np)
+        return torch.from_numpy(out)
+
+    @staticmethod
+    def backward(ctx, grad: torch.Tensor):
+        idx_np, v_np = ctx.mix
+        dw = np.empty(idx_np.shape, v_np.dtype)
+        _mix_backward(grad.detach().contiguous().numpy(), idx_np, v_np, dw)
+        return torch.from_numpy(dw), None, None
+
+
 def _weights(weights: tuple[torch.Tensor, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(W_lᵀ (L, H, H), W_l (L, H, H), b_l (L, H)) numpy arrays of the hidden layers."""
     w = torch.stack(weights[::2]).detach()
@@ -172,7 +256,8 @@ class FusedRingMessages(torch.autograd.Function):
         shape = (len(wt) + 1, bsz * 3 * n, h) if keep else (0, 0, h)
         masks = np.empty(shape, np.bool_)
         slope = u_np.dtype.type(LEAKY_SLOPE)
-        _forward(u_np, c_np, ring_np, wt, b, out, masks, slope, _tile(n))
+        with _serial_blas():
+            _forward(u_np, c_np, ring_np, wt, b, out, masks, slope, _tile(n))
         if keep:
             ctx.fused = (ring_np, w, masks)
         return torch.from_numpy(out)
@@ -183,6 +268,7 @@ class FusedRingMessages(torch.autograd.Function):
         g = grad.detach().contiguous().numpy()
         du = np.zeros_like(g)
         dc = np.empty_like(g)
-        _backward(g, ring_np, w, masks, du, dc, g.dtype.type(LEAKY_SLOPE), _tile(g.shape[1]))
+        with _serial_blas():
+            _backward(g, ring_np, w, masks, du, dc, g.dtype.type(LEAKY_SLOPE), _tile(g.shape[1]))
         rest = (None for _ in ctx.needs_input_grad[3:])
         return (torch.from_numpy(du), torch.from_numpy(dc), None, *rest)

@@ -10,7 +10,7 @@ import torch
 from torch import nn
 
 from ...graph import GraphBatch, RobotGraph
-from .fused import FusedRingMessages
+from .fused import FusedRingMessages, SparseMix
 from .geometry import _pairwise_d2, nearest_candidates, nearest_obstacle_nodes, signed_ring_distance
 from .layers import _LeakyRingMessages
 
@@ -181,7 +181,8 @@ class LeanInference:
         self, nodes: torch.Tensor, scene: SceneGraph, fused: bool = False
     ) -> torch.Tensor:
         """:meth:`lean` for ``two_way=False``: only the robot graph runs per configuration;
-        partner terms, partner scores and the obstacle readout come from ``scene.fixed``."""
+        partner terms, partner scores and the obstacle readout come from ``scene.fixed``
+        (``fused``: the cross terms by :class:`~.fused.SparseMix` as well)."""
         c, fixed = self.config, scene.fixed
         b, n_o = nodes.shape[0], len(scene.obstacles)
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
@@ -193,10 +194,16 @@ class LeanInference:
             if k:
                 logits = logits + fixed.score[k].take(idx)
             w = _softmax_small(logits)
-            m_ro = w.new_zeros(*idx.shape[:2], n_o).scatter_add_(-1, idx, w)  # (B, N_r, N_o)
+            if fused:  # Σ_c w_ic v_{j_c} over the C candidates only
 
-            def mix(v: torch.Tensor, m_ro=m_ro, v_o=fixed.v[k]) -> torch.Tensor:
-                return m_ro @ v_o
+                def mix(v: torch.Tensor, w=w, v_o=fixed.v[k]) -> torch.Tensor:
+                    return SparseMix.apply(w, idx, v_o)
+
+            else:
+                m_ro = w.new_zeros(*idx.shape[:2], n_o).scatter_add_(-1, idx, w)  # (B, N_r, N_o)
+
+                def mix(v: torch.Tensor, m_ro=m_ro, v_o=fixed.v[k]) -> torch.Tensor:
+                    return m_ro @ v_o
 
             z = xr if h is None else torch.cat([xr, h], -1)
             h = self._lean_conv(k, z, mix, scene.robot_ring, s, fused)
