@@ -16,7 +16,12 @@ import torch
 
 import gdnplan as gp
 from gdnplan.errors import InputError
-from gdnplan.models.graphdistnet import GraphDistNet, GraphDistNetConfig, GraphDistNetModel
+from gdnplan.models.graphdistnet import (
+    GraphDistNet,
+    GraphDistNetConfig,
+    GraphDistNetModel,
+    load_graphdistnet_weights,
+)
 from gdnplan.models.graphdistnet import fused as fused_kernel
 
 WEIGHTS = Path(__file__).resolve().parent.parent / "weights"
@@ -79,6 +84,9 @@ def test_fused_setting_resolves_by_network_and_refuses_what_it_cannot_serve(monk
     assert not model(cross="argmax").fused  # the padded reference forward serves it
     with pytest.raises(InputError, match="fused"):
         model(fused=True, mlp=(32, 16))
+    assert load_graphdistnet_weights(WEIGHTS / "d.safetensors").fused
+    assert not load_graphdistnet_weights(WEIGHTS / "d.safetensors", fused=False).fused
+    assert not load_graphdistnet_weights(WEIGHTS / "d_faithful.safetensors").fused  # argmax
     monkeypatch.setattr(fused_kernel, "AVAILABLE", False)
     assert not model().fused
     with pytest.raises(InputError, match="numba is not installed"):
