@@ -42,7 +42,7 @@ except ImportError:  # the reference path serves (GraphDistNetModel's default)
 
 AVAILABLE = numba is not None
 TILE_ROWS = 4096  # edge rows per tile (3 N per configuration): 512 kB per buffer, in L2
-# (larger tiles keep sgemm efficient; docs/decisions.md#fused-inference)
+# (larger tiles keep sgemm efficient; docs/decisions.md#fused-kernels)
 
 __all__ = ["AVAILABLE", "TILE_ROWS", "FusedRingMessages", "SparseMix", "supports"]
 
@@ -63,7 +63,7 @@ def _blas_libraries() -> list:
 def _serial_blas() -> Iterator[None]:
     """The BLAS libraries on one thread inside: the kernels' products are small (one tile),
     and a BLAS thread pool waiting on a busy core costs far more than it gains
-    (docs/decisions.md#fused-inference); the caller's counts are restored after."""
+    (docs/decisions.md#fused-kernels); the caller's counts are restored after."""
     libraries = _blas_libraries()
     counts = [lib.num_threads for lib in libraries]
     for lib in libraries:
