@@ -1,19 +1,29 @@
-"""GraphDistNet vs coal: seconds for a batch of configurations, measured side by side in one run.
+"""GraphDistNet (torch reference and fused kernels) vs coal: seconds for a batch of
+configurations, measured side by side in one run.
 
 For each scene with weights (``<weights>/<env>.safetensors``, the shipped ones by default; the
 UR5e ``fetch`` scene uses ``ur5e.safetensors``), on one scene (seed 0) and the same n uniformly
 random configurations: coal distance and distance + exact gradient (bounding-circle broad
 phase, batches split over all cores by processes) and GraphDistNet distance and distance +
-∂d̂/∂q (float32, ``--threads`` torch threads), best of the repeats after one warm-up call each.
-Also the achieved GFLOP/s of the GraphDistNet distance pass (matmul FLOPs counted by torch's
-FlopCounterMode) against the GFLOP/s of a 2048² float32 matmul with the same threads.
+∂d̂/∂q (float32, ``--threads`` torch threads) by the torch reference path (``fused=False``)
+and by the fused kernels (``fused=True``, models/graphdistnet/fused.py), best of the repeats
+after one warm-up call each, all six interleaved round by round.
 
-    python benchmarks/inference.py --threads 1 [--n 5000] [--repeats 3] [--envs a b c d e fetch]
-    python benchmarks/inference.py --threads 2 --envs d e \
-        --out benchmarks/results/inference_2threads.md
+FLOPs: the matmul FLOPs torch runs (FlopCounterMode) plus the fused kernels' products (2 R H²
+per hidden layer of the edge MLP on R edge rows, forward and backward; 2 n C H for the sparse
+cross mix), counted by wrapping the kernels. Reported: GFLOP/s of the fused kernels alone
+(their FLOPs over their thread CPU seconds) and of the whole fused distance + gradient pass
+(all its FLOPs over its best thread CPU seconds), each as a share of a 2048² float32 matmul
+on this thread (thread CPU seconds too: the machine is shared, CPU time is what a busy core
+still measures fairly).
+
+    python benchmarks/inference.py --threads 1 [--n 5000] [--repeats 5] [--envs a b c d e fetch]
 """
 
 from __future__ import annotations
+
+import time
+from collections.abc import Callable
 
 import common
 import torch
@@ -22,68 +32,117 @@ from torch.utils.flop_counter import FlopCounterMode
 import gdnplan as gp
 from gdnplan import distance
 from gdnplan.assets import default_weights
+from gdnplan.models.graphdistnet import fused
+
+KERNELS = {  # fused.py's compiled functions: FLOPs of one call from its arguments
+    "_forward": lambda u, c, ring, wt, *_: 2 * u.shape[0] * 3 * u.shape[1] * wt.size,
+    "_backward": lambda g, ring, w, *_: 2 * g.shape[0] * 3 * g.shape[1] * w.size,
+    "_mix_forward": lambda w, idx, v, out: 2 * w.size * v.shape[1],
+    "_mix_backward": lambda g, idx, v, dw: 2 * idx.size * v.shape[1],
+}
+
+
+def cpu_seconds(call: Callable[[], object], repeats: int) -> float:
+    """Best thread CPU seconds of ``call`` after one warm-up call."""
+    call()
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.thread_time()
+        call()
+        best = min(best, time.thread_time() - start)
+    return best
 
 
 def matmul_gflops(size: int = 2048, repeats: int = 5) -> float:
-    """GFLOP/s of a float32 (size × size) matmul: the practical peak of this CPU."""
+    """GFLOP/s of a float32 (size × size) matmul on this thread: the practical peak."""
     a, b = torch.randn(size, size), torch.randn(size, size)
-    seconds = common.time_calls({"mm": lambda: a @ b}, repeats=repeats)["mm"].best
-    return 2 * size**3 / seconds / 1e9
+    return 2 * size**3 / cpu_seconds(lambda: a @ b, repeats) / 1e9
 
 
-def forward_flops(model, scene: gp.Scene, q) -> int:
-    """Matmul FLOPs of ``model.distance(scene, q)``."""
-    with FlopCounterMode(display=False) as counter:
-        model.distance(scene, q)
-    return counter.get_total_flops()
+def metered(call: Callable[[], object]) -> tuple[int, int, float]:
+    """(torch matmul FLOPs, kernel FLOPs, kernel thread CPU seconds) of one ``call``."""
+    originals = {name: getattr(fused, name) for name in KERNELS}
+    kernel = {"flops": 0, "seconds": 0.0}
+
+    def wrap(name: str):
+        def run(*args):
+            start = time.thread_time()
+            originals[name](*args)
+            kernel["seconds"] += time.thread_time() - start
+            kernel["flops"] += KERNELS[name](*args)
+
+        return run
+
+    try:
+        for name in KERNELS:
+            setattr(fused, name, wrap(name))
+        with FlopCounterMode(display=False) as counter:
+            call()
+    finally:
+        for name, original in originals.items():
+            setattr(fused, name, original)
+    return counter.get_total_flops(), kernel["flops"], kernel["seconds"]
 
 
 def row(table: common.Table, env: str, n: int, repeats: int, peak: float) -> None:
-    """One table row: seconds of coal and GraphDistNet for n configurations of scene ``env``."""
+    """One table row: seconds of coal and both GraphDistNet paths for n configurations."""
     scene = gp.make_scene(env, seed=0)
     q = scene.robot.sample(n, seed=0)
-    model = gp.load_model(default_weights(scene))
+    name = default_weights(scene)
+    reference, fast = (gp.load_model(name) for _ in range(2))
+    reference.fused, fast.fused = False, True
     distance.checker(scene)
     calls = {
         "coal d": lambda: gp.signed_distance(scene, q),
         "coal d+grad": lambda: gp.signed_distance_and_grad(scene, q),
-        "GDN d": lambda: model.distance(scene, q),
-        "GDN d+grad": lambda: model.distance_and_grad(scene, q),
+        "ref d": lambda: reference.distance(scene, q),
+        "ref d+grad": lambda: reference.distance_and_grad(scene, q),
+        "fused d": lambda: fast.distance(scene, q),
+        "fused d+grad": lambda: fast.distance_and_grad(scene, q),
     }
-    t = {name: timing.best for name, timing in common.time_calls(calls, repeats).items()}
-    gflops = forward_flops(model, scene, q) / t["GDN d"] / 1e9
+    t = {key: timing.best for key, timing in common.time_calls(calls, repeats).items()}
+    torch_flops, kernel_flops, kernel_seconds = metered(calls["fused d+grad"])
+    pass_cpu = cpu_seconds(calls["fused d+grad"], repeats)
+    kernel_gflops = kernel_flops / kernel_seconds / 1e9
+    pass_gflops = (torch_flops + kernel_flops) / pass_cpu / 1e9
     table.add(
-        f"{env} ({scene.robot.name})",
-        *(f"{s:.3f}" for s in t.values()),
-        f"{t['GDN d'] / t['coal d']:.1f}×",
-        f"{t['GDN d+grad'] / t['coal d+grad']:.1f}×",
-        f"{gflops:.1f} ({100 * gflops / peak:.0f} %)",
+        f"{env} ({scene.robot.name}, {name})",
+        *(f"{t[key]:.3f}" for key in calls),
+        f"{t['fused d'] / t['coal d']:.2f}×",
+        f"{t['fused d+grad'] / t['coal d+grad']:.2f}×",
+        f"{t['fused d+grad'] / t['ref d+grad']:.2f}×",
+        f"{kernel_gflops:.1f} ({100 * kernel_gflops / peak:.0f} %)",
+        f"{pass_gflops:.1f} ({100 * pass_gflops / peak:.0f} %), {pass_cpu:.3f} s",
     )
 
 
 def main() -> None:
     p = common.parser("inference", __doc__)
     p.add_argument("--n", type=int, default=5000)
-    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--envs", nargs="+", default=["a", "b", "c", "d", "e", "fetch"])
     args = common.parse(p)
     report = common.Report(args, "Inference: GraphDistNet vs coal", common.first_paragraph(__doc__))
     peak = matmul_gflops()
     report.text(
-        f"n = {args.n} configurations, best of {args.repeats}; weights: the shipped default of "
-        f"each scene (gdnplan.assets.default_weights); coal over all cores (forked workers), "
-        f"GraphDistNet on {args.threads} torch thread(s); float32 matmul peak "
-        f"({args.threads} threads): {peak:.1f} GFLOP/s."
+        f"n = {args.n} configurations, best of {args.repeats} (wall s); weights: the shipped "
+        f"default of each scene (gdnplan.assets.default_weights); coal over all cores (forked "
+        f"workers), GraphDistNet on {args.threads} torch thread(s); float32 matmul peak on "
+        f"this thread: {peak:.1f} GFLOP/s (thread CPU time)."
     )
     table = report.table(
-        "env (robot)",
+        "env (robot, weights)",
         "coal d (s)",
         "coal d+grad (s)",
-        "GDN d (s)",
-        "GDN d+grad (s)",
-        "GDN/coal d",
-        "GDN/coal d+grad",
-        "GDN d GFLOP/s (share of peak)",
+        "ref d (s)",
+        "ref d+grad (s)",
+        "fused d (s)",
+        "fused d+grad (s)",
+        "fused/coal d",
+        "fused/coal d+grad",
+        "fused/ref d+grad",
+        "fused kernels GFLOP/s (share of peak)",
+        "fused d+grad pass GFLOP/s (share), CPU s",
     )
     for env in args.envs:
         row(table, env, args.n, args.repeats, peak)

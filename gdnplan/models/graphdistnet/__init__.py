@@ -57,12 +57,17 @@ Inference (:class:`GraphDistNetModel`, ``soft_knn``) runs :meth:`GraphDistNet.le
 function for one scene without padding: ring neighbours by one shared index, the cross terms
 as dense batched products, the last linear layer of h_k after the sum over the edges and, for
 LeakyReLU, the edge MLP with a hand-written backward (:class:`_LeakyRingMessages`). Tests
-prove it equal to :meth:`GraphDistNet.forward` (values and gradients).
+prove it equal to :meth:`GraphDistNet.forward` (values and gradients). Where numba is installed
+(a core dependency), the edge MLP runs by the fused kernels of :mod:`.fused` instead, tile by
+tile in cache (and one-way cross terms over the candidates only); ``GraphDistNetModel(fused=…)``
+selects them (default: wherever they serve the network), tests prove them equal to the torch
+path on every shipped weights file.
 
 Modules: :mod:`.config` (options), :mod:`.geometry` (candidates, ring distances),
 :mod:`.layers` (MLPs, readout softmax, ring messages), :mod:`.network` (the module and its
 padded forward), :mod:`.lean` (the lean inference path), :mod:`.model` (the DistanceModel
-wrapper), :mod:`.load` (weights files: :func:`load_graphdistnet_weights`).
+wrapper), :mod:`.load` (weights files: :func:`load_graphdistnet_weights`), :mod:`.fused` (the
+fused numba kernels of the lean path).
 """
 
 from .config import GraphDistNetConfig

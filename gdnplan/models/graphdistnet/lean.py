@@ -10,6 +10,7 @@ import torch
 from torch import nn
 
 from ...graph import GraphBatch, RobotGraph
+from .fused import FusedRingMessages, SparseMix
 from .geometry import _pairwise_d2, nearest_candidates, nearest_obstacle_nodes, signed_ring_distance
 from .layers import _LeakyRingMessages
 
@@ -130,8 +131,10 @@ class LeanInference:
             readout.append(self._lean_pool(h, s)[0])
         return ObstacleFeatures(torch.stack(v), torch.stack(score[:-1]), torch.stack(readout))
 
-    def lean(self, nodes: torch.Tensor, scene: SceneGraph) -> torch.Tensor:
-        """d̂ (B,) (m) of robot nodes (B, N_r, 2) (m) among one scene's obstacles.
+    def lean(self, nodes: torch.Tensor, scene: SceneGraph, fused: bool = False) -> torch.Tensor:
+        """d̂ (B,) (m) of robot nodes (B, N_r, 2) (m) among one scene's obstacles; ``fused``:
+        the ring messages by :class:`~.fused.FusedRingMessages` (on CPU), else by
+        :class:`~.layers._LeakyRingMessages` (the same function).
 
         The function of :meth:`forward` for ``cross="soft_knn"`` without padding, reorganised
         for inference: ring neighbours are gathered with one index shared by the batch, the
@@ -141,7 +144,7 @@ class LeanInference:
         Σ_e (W a_e + b) = W Σ_e a_e + 3 b. One-way networks run :meth:`lean_one_way`.
         """
         if scene.fixed is not None:
-            return self.lean_one_way(nodes, scene)
+            return self.lean_one_way(nodes, scene, fused)
         c = self.config
         b, n_r, _ = nodes.shape
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
@@ -162,7 +165,7 @@ class LeanInference:
             def mix(v: torch.Tensor, m_ro=m_ro, m_or=m_or) -> torch.Tensor:
                 return torch.cat([m_ro @ v[:, n_r:], m_or @ v[:, :n_r]], 1)
 
-            h = self._lean_conv(k, z, mix, scene.ring, s)
+            h = self._lean_conv(k, z, mix, scene.ring, s, fused)
             score = h @ self.attention[k]
             y = torch.cat(
                 [
@@ -174,9 +177,12 @@ class LeanInference:
             pooled = y if pooled is None else torch.maximum(pooled, y)
         return self._lean_estimate(pooled, xr, scene, s)
 
-    def lean_one_way(self, nodes: torch.Tensor, scene: SceneGraph) -> torch.Tensor:
+    def lean_one_way(
+        self, nodes: torch.Tensor, scene: SceneGraph, fused: bool = False
+    ) -> torch.Tensor:
         """:meth:`lean` for ``two_way=False``: only the robot graph runs per configuration;
-        partner terms, partner scores and the obstacle readout come from ``scene.fixed``."""
+        partner terms, partner scores and the obstacle readout come from ``scene.fixed``
+        (``fused``: the cross terms by :class:`~.fused.SparseMix` as well)."""
         c, fixed = self.config, scene.fixed
         b, n_o = nodes.shape[0], len(scene.obstacles)
         xr = (nodes - nodes.new_tensor(c.origin)) / c.scale
@@ -188,13 +194,19 @@ class LeanInference:
             if k:
                 logits = logits + fixed.score[k].take(idx)
             w = _softmax_small(logits)
-            m_ro = w.new_zeros(*idx.shape[:2], n_o).scatter_add_(-1, idx, w)  # (B, N_r, N_o)
+            if fused:  # Σ_c w_ic v_{j_c} over the C candidates only
 
-            def mix(v: torch.Tensor, m_ro=m_ro, v_o=fixed.v[k]) -> torch.Tensor:
-                return m_ro @ v_o
+                def mix(v: torch.Tensor, w=w, v_o=fixed.v[k]) -> torch.Tensor:
+                    return SparseMix.apply(w, idx, v_o)
+
+            else:
+                m_ro = w.new_zeros(*idx.shape[:2], n_o).scatter_add_(-1, idx, w)  # (B, N_r, N_o)
+
+                def mix(v: torch.Tensor, m_ro=m_ro, v_o=fixed.v[k]) -> torch.Tensor:
+                    return m_ro @ v_o
 
             z = xr if h is None else torch.cat([xr, h], -1)
-            h = self._lean_conv(k, z, mix, scene.robot_ring, s)
+            h = self._lean_conv(k, z, mix, scene.robot_ring, s, fused)
             y_r = self._lean_pool(h, h @ self.attention[k])
             y = torch.cat([y_r, fixed.readout[k].expand(b, -1)], -1)
             pooled = y if pooled is None else torch.maximum(pooled, y)
@@ -207,6 +219,7 @@ class LeanInference:
         mix: Callable[[torch.Tensor], torch.Tensor],
         ring: torch.Tensor,
         s: torch.Tensor | None = None,
+        fused: bool = False,
     ) -> torch.Tensor:
         """x⁽ᵏ⁺¹⁾ (B, N, d_h): Σ of h_k over the edges (prev, next, self) of every node.
 
@@ -215,6 +228,7 @@ class LeanInference:
             mix: v (B, N, d_h) ↦ v̄ (B, N, d_h), v̄_i = Σ_c w_ic v_c (the cross terms).
             ring: (2 N,) prev and next indices.
             s: (B, N) node distances (``node_distance``), or None.
+            fused: the ring messages by the fused kernel (:meth:`lean`).
         """
         first, *rest = self.convs[k]  # a list: slicing the Sequential would build a new one
         d = z.shape[-1]
@@ -226,7 +240,8 @@ class LeanInference:
             ring_edges = u.index_select(1, ring).view(b, 2, n, hd) - u[:, None] + c[:, None]
             return torch.cat([ring_edges, c[:, None]], 1).sum(1)  # (B, 3, N, H) summed
         hidden = [m for m in rest[:-1] if isinstance(m, nn.Linear)]
-        msg = _LeakyRingMessages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
+        messages = FusedRingMessages if fused else _LeakyRingMessages
+        msg = messages.apply(u, c, ring, *(t for m in hidden for t in m.parameters()))
         last = rest[-1]
         return nn.functional.linear(msg, last.weight, 3 * last.bias)
 

@@ -13,10 +13,13 @@ from .model import GraphDistNetModel
 from .network import GraphDistNet
 
 
-def load_graphdistnet_weights(path: Path | str, threads: int | None = None) -> GraphDistNetModel:
+def load_graphdistnet_weights(
+    path: Path | str, threads: int | None = None, fused: bool | None = None
+) -> GraphDistNetModel:
     """A :class:`GraphDistNetModel` from the weights file ``path`` (safetensors) and the JSON
     card beside it, running inference with ``threads`` torch threads (None: the library
-    default, 1). Old flat cards load unchanged (:mod:`.config`)."""
+    default, 1) and the ``fused`` kernels (None: wherever they serve the network; see
+    :class:`GraphDistNetModel`). Old flat cards load unchanged (:mod:`.config`)."""
     threads = check_threads(threads)
     path = Path(path)
     tensors, card = read_weights(path)
@@ -25,7 +28,7 @@ def load_graphdistnet_weights(path: Path | str, threads: int | None = None) -> G
         check_count(value, len(tensors), name, path)  # else a huge network before the check
     check_count(len(config.readout) or 1, len(tensors), "readout", path)
     net = build_net(path, "GraphDistNet", lambda: GraphDistNet(config), tensors)
-    return GraphDistNetModel(net, card, threads=threads)
+    return GraphDistNetModel(net, card, threads=threads, fused=fused)
 
 
 def load_graphdistnet(path: Path | str, threads: int | None = None) -> GraphDistNetModel:

@@ -12,10 +12,12 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from ...errors import InputError
 from ...graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
 from ...scene import Scene
 from ..checks import check_fits
 from ..threads import check_threads, torch_threads
+from . import fused as fused_kernel
 from .lean import SceneGraph
 from .network import GraphDistNet
 
@@ -37,6 +39,12 @@ class GraphDistNetModel:
     a scene are built once per scene object (scenes are immutable) and cached. Results are
     float64 numpy arrays. Inference runs with ``threads`` torch threads (None: the library
     default, 1; :mod:`gdnplan.models.threads`), the caller's count restored after each call.
+
+    ``fused`` selects the kernel of the lean path's ring messages: True the fused numba kernels
+    (:mod:`.fused`: on CPU, hidden layers of one width, numba installed), False the
+    torch reference (:class:`~.layers._LeakyRingMessages`), None (default) the fused kernels
+    where they serve the network, else the reference. The two compute the same function
+    (tests/test_graphdistnet_fused.py).
     """
 
     name = "graphdistnet"
@@ -49,6 +57,7 @@ class GraphDistNetModel:
         dtype: torch.dtype = torch.float32,
         device: str | torch.device = "cpu",
         threads: int | None = None,
+        fused: bool | None = None,
     ):
         self.net = net.to(device, dtype).eval()
         self.threads = check_threads(threads)
@@ -57,7 +66,25 @@ class GraphDistNetModel:
         self.chunk = chunk
         self.dtype = dtype
         self.device = torch.device(device)
+        self.fused = self._check_fused(fused)
         self._scenes: weakref.WeakKeyDictionary[Scene, _SceneCache] = weakref.WeakKeyDictionary()
+
+    def _check_fused(self, fused: bool | None) -> bool:
+        """The ``fused`` setting resolved (class docstring); InputError when True cannot be."""
+        c = self.config
+        serves = (
+            fused_kernel.supports(c.mlp)
+            and c.cross == "soft_knn"
+            and self.dtype in (torch.float32, torch.float64)
+            and self.device.type == "cpu"
+        )
+        if fused and not serves:
+            why = "numba is not installed" if not fused_kernel.AVAILABLE else "not this network"
+            raise InputError(
+                "fused: the fused kernel serves soft_knn networks with hidden layers of one "
+                f"width, float32 on CPU ({why}); use fused=None or False"
+            )
+        return serves if fused is None else fused
 
     def check_scene(self, scene: Scene) -> None:
         """InputError unless the weights were trained for ``scene``'s robot (models/checks.py)."""
@@ -82,7 +109,7 @@ class GraphDistNetModel:
     ) -> torch.Tensor:
         """d̂ (B,) (m) of robot nodes (B, N_r, 2) (m)."""
         if graphs.lean is not None:
-            return self.net.lean(nodes, graphs.lean)
+            return self.net.lean(nodes, graphs.lean, self.fused)
         robot = graphs.robot.batch(nodes, device=self.device, dtype=self.dtype)
         return self.net(robot, _repeat(graphs.obstacles, len(nodes)), gen)
 
