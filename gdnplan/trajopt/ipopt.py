@@ -14,6 +14,7 @@ import numpy as np
 from ..casadi_bridge import supports_per_link
 from ..ccd import certify_path
 from ..distance import signed_distance
+from ..limits import MAX_SEEDS
 from ..models import CoalModel, DistanceModel
 from .check_points import (
     _check_point_raise,
@@ -70,7 +71,8 @@ def _plan_ipopt(
     """Straight line when certified free, else Ipopt from each seed; the cheapest certified.
 
     Seeds i = 0, 1, … (kind ``kinds[i % len(kinds)]``, stream seed + i) are refined until
-    ``seed_count`` are certified, ``starts`` have ended uncertified, or the clock passes
+    ``seed_count`` are certified, ``starts`` have ended uncertified (without a time budget;
+    within one, a failed seed draws the next until the budget ends), or the clock passes
     ``deadline``. An attempt that ends uncertified suggests check points too sparse for the
     problem, so after f such attempts a seed starts with ``interpolated + min(f, starts − 1)``
     check points per segment (on one (d) problem, #14, all three attempts with 2 check points
@@ -85,8 +87,9 @@ def _plan_ipopt(
     clearance = _seed_clearance(problem, goal, sc.rrt_clearance)
     run, best, failures = _Run(q=line), _Best(), 0
     first, wanted = cfg.optimizer.interpolated, sc.seed_count
-    for index in range(wanted + sc.starts - 1):
-        if best.certified == wanted or failures == sc.starts:
+    budgeted = math.isfinite(deadline)
+    for index in range(wanted + (MAX_SEEDS if budgeted else sc.starts - 1)):
+        if best.certified == wanted or (failures == sc.starts and not budgeted):
             break
         if time.perf_counter() >= deadline:
             run.reason = f"{run.reason}; time budget ended".lstrip("; ")

@@ -17,19 +17,23 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from importlib.util import find_spec
 
 import numpy as np
 
 from ..distance import signed_distance
 from ..errors import InputError
+from ..path_metrics import resample_arc_length
 from ..rrt import resample, rrt_connect, seed_path, shortcut
 from .check_points import straight_line
-from .config import SEED_KINDS
+from .config import MISSING_SEED_KINDS, SEED_KINDS
 from .problem import Problem
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
 VIA_DRAWS = 100  # random via points drawn until one clears the demanded clearance
+OMPL_TIME = 1.0  # s: planning + simplification of one OMPL seed (docs/decisions.md)
+HAS_OMPL = find_spec("ompl") is not None
 
 
 @dataclass(frozen=True)
@@ -140,7 +144,37 @@ def straight_seed(request: SeedRequest) -> np.ndarray:
     return guess
 
 
+def aorrtc_seed(request: SeedRequest) -> np.ndarray | None:
+    """OMPL's asymptotically optimal AORRTC under the path-length objective, simplified
+    (:func:`gdnplan.ompl_planner.plan_ompl`), its states and motions certified above the
+    smaller of ``request.clearance`` and the margin (the shortest way may pass where only the
+    margin fits), within ``OMPL_TIME`` s of planning and simplification; resampled to T
+    waypoints equally spaced in joint-space arc length
+    (:func:`gdnplan.path_metrics.resample_arc_length`: on a fixed polyline, the spacing of
+    least Σ‖Δq‖²). OMPL seeds its generator once per process, so ``request.stream`` does not
+    pick its run (not reproducible). Needs OMPL (``pip install 'gdnplan[bench]'``)."""
+
+    from ..ompl_planner import plan_ompl
+
+    p = request.problem
+    budget = min(request.time_limit, OMPL_TIME)
+    clearance = min(request.clearance, p.margin)  # not more: the short way may be narrow
+    r = plan_ompl(
+        p.scene, p.start, request.goal, clearance, "aorrtc", budget,
+        seed=request.stream, lower=p.lower, upper=p.upper,
+    )  # fmt: skip
+    if not r.success:
+        return None
+    return resample_arc_length(r.path, p.waypoints)
+
+
 SEED_KINDS.update(rrt=rrt_seed, via=via_seed, straight=straight_seed)
+if HAS_OMPL:
+    SEED_KINDS["aorrtc"] = aorrtc_seed
+else:
+    MISSING_SEED_KINDS["aorrtc"] = (
+        "needs OMPL, which is not installed (pip install 'gdnplan[bench]')"
+    )
 
 
 def register_seed_kind(name: str, source: SeedSource) -> None:
@@ -195,6 +229,7 @@ __all__ = [
     "SeedInfo",
     "SeedRequest",
     "SeedSource",
+    "aorrtc_seed",
     "draw_seed",
     "register_seed_kind",
     "rrt_seed",
