@@ -234,7 +234,7 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=1, help="torch threads")
     parser.add_argument("--envs", nargs="+", default=["b", "d", "fetch"])
     parser.add_argument("--problems", type=int, default=20)
-    parser.add_argument("--budgets", nargs="+", type=float, default=[1.0, 3.0])
+    parser.add_argument("--budgets", nargs="*", type=float, default=[1.0, 3.0])
     parser.add_argument("--planners", nargs="+", default=["rrtconnect", "bitstar", "aorrtc"])
     parser.add_argument("--seed", type=int, default=0, help="OMPL's random seed")
     parser.add_argument("--seeds", type=int, help="gdnplan's seed count (default: its own)")

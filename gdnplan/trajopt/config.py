@@ -143,7 +143,11 @@ class RefineConfig:
             buffer leaves the path room to bend between check points.
         raise_window: (Ipopt, learned models) a refine round raises the model's margin on the
             rejected segments and this many segments either side of each; None: on the
-            whole path (docs/decisions.md#raise-window).
+            whole path (docs/decisions.md#raise-window). With ``exact_rows``: the segments
+            that get coal rows.
+        exact_rows: (Ipopt, learned models) a refine round constrains the check points of
+            those segments by coal's exact distance instead of the model's raised bound
+            (:mod:`gdnplan.trajopt.refine`).
     """
 
     ccd: bool = True
@@ -151,9 +155,10 @@ class RefineConfig:
     warm_start: bool = True
     clearance_buffer: float = 0.002
     raise_window: int | None = 2
+    exact_rows: bool = True
 
     def __post_init__(self) -> None:
-        _check_bools(self, ("ccd", "warm_start"))
+        _check_bools(self, ("ccd", "warm_start", "exact_rows"))
         check_int(self.rounds, "rounds", 0, MAX_REFINE_ROUNDS)
         check_number(self.clearance_buffer, "clearance_buffer")
         if self.raise_window is not None:
