@@ -1,17 +1,20 @@
 """gdnplan against OMPL's planners on the Table II problems, one validity rule and one certificate.
 
 Usage: python benchmarks/ompl_compare.py --threads 1 [--envs b d fetch] [--problems N]
-       [--budgets 1 3] [--planners rrtconnect bitstar aorrtc] [--out benchmarks/results/…]
+       [--budgets [1 3]] [--planners rrtconnect bitstar aorrtc] [--seeds N] [--kinds rrt …]
+       [--out benchmarks/results/…]
 
 Problems: the first N of the 20 Table II problems of each setting
 (:func:`gdnplan.table2.reaching_problems`: (b), (d) and the fetch layouts, seed 0).
 Methods, on every problem in one run:
 
-- gdnplan, ``gp.plan(problem)`` with its defaults: coal constraints, and GraphDistNet
-  constraints (the shipped weights of the setting by name, loaded once per setting);
+- gdnplan, ``gp.plan(problem)`` with its defaults (``--seeds`` / ``--kinds`` change the seed
+  count and kinds): coal constraints, and GraphDistNet constraints (the shipped weights of the
+  setting by name, loaded once per setting);
 - OMPL (:func:`gdnplan.ompl_planner.plan_ompl`): each planner + path simplification with each
-  time budget of ``--budgets`` (s) and with "=t", the wall time gdnplan (coal) used on that
-  problem (equal time).
+  time budget of ``--budgets`` (s; none: equal time only) and with "=t", the wall time gdnplan
+  (coal) used on that problem (equal time). A budget is OMPL's whole wall time, simplification
+  included.
 
 Validity is the same for every method: the problem's certified clearance c
 (``Problem.certified_clearance``, the margin) along the whole continuous path. OMPL's states
