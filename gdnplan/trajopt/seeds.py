@@ -32,6 +32,9 @@ from .problem import Problem
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
 VIA_DRAWS = 100  # random via points drawn until one clears the demanded clearance
+SCREENED = 4  # RRT-Connect paths drawn per rrt seed; the cheapest is refined (decisions.md)
+SCREEN_TIME = 1.0  # s: the draws after the first share this
+SCREEN_STRIDE = 100_003  # stream offset of draw j (far from the streams of other seeds)
 OMPL_TIME = 1.0  # s: planning + simplification of one OMPL seed (docs/decisions.md)
 HAS_OMPL = find_spec("ompl") is not None
 
@@ -80,19 +83,35 @@ class SeedInfo:
 
 
 def rrt_seed(request: SeedRequest) -> np.ndarray | None:
-    """RRT-Connect + shortcut + resample (:func:`gdnplan.rrt.seed_path`) on ``request.stream``."""
+    """The cheapest of up to ``SCREENED`` RRT-Connect + shortcut + resample paths
+    (:func:`gdnplan.rrt.seed_path`; path j on stream ``request.stream + SCREEN_STRIDE · j``,
+    path 0 on ``request.stream`` itself) by path cost Σ‖Δq‖²: RRT-Connect's paths fall into
+    different homotopy classes, and refining the cheapest draw is far cheaper than refining
+    each. Paths after the first share ``SCREEN_TIME`` s (and ``request.time_limit``)."""
     p = request.problem
-    path, _ = seed_path(
-        p.scene,
-        p.start,
-        request.goal,
-        p.waypoints,
-        request.clearance,
-        seed=request.stream,
-        time_limit=request.time_limit,
-        step=request.rrt_step,
-    )
-    return path
+    t0, best, best_cost = time.perf_counter(), None, math.inf
+    first = t0  # when the first draw ended
+    for j in range(SCREENED):
+        left = request.time_limit - (time.perf_counter() - t0)
+        if j:
+            left = min(left, SCREEN_TIME - (time.perf_counter() - first))
+        if left <= 0:
+            break
+        path, _ = seed_path(
+            p.scene,
+            p.start,
+            request.goal,
+            p.waypoints,
+            request.clearance,
+            seed=request.stream + SCREEN_STRIDE * j,
+            time_limit=left,
+            step=request.rrt_step,
+        )
+        if j == 0:
+            first = time.perf_counter()
+        if path is not None and (cost := float(np.sum(np.diff(path, axis=0) ** 2))) < best_cost:
+            best, best_cost = path, cost
+    return best
 
 
 def via_seed(request: SeedRequest) -> np.ndarray | None:
