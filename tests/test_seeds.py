@@ -244,3 +244,41 @@ def test_plan_flags_that_do_not_apply_are_input_errors(args, message, capsys):
     code, _, err = cli(["plan", "planar2_square", "--collision", "coal", "-q", *args], capsys)
     assert code == 2 and err.count("\n") == 1
     assert err.startswith("error: ") and message in err, err
+
+
+def test_an_aorrtc_seed_is_refined_and_certified():
+    pytest.importorskip("ompl")
+    problem = Problem.from_toml("planar2_square")
+    cfg = PlanConfig(seed=SeedConfig(kinds=("aorrtc",), count=1))
+    result = plan(problem, collision="coal", solver=cfg)
+    assert result.success, result.reason
+    assert result.seed.kind == "aorrtc"
+    assert_certified(problem, result)
+
+
+def test_a_seed_kind_whose_dependency_is_missing_says_how_to_install_it(monkeypatch):
+    from gdnplan.trajopt.config import MISSING_SEED_KINDS
+
+    monkeypatch.delitem(SEED_KINDS, "aorrtc", raising=False)
+    monkeypatch.setitem(MISSING_SEED_KINDS, "aorrtc", "needs OMPL, which is not installed (…)")
+    with pytest.raises(gp.InputError, match="kinds: seed kind 'aorrtc' needs OMPL"):
+        SeedConfig(kinds=("rrt", "aorrtc"))
+
+
+def test_an_rrt_seed_is_the_cheapest_of_its_draws(monkeypatch):
+    """The rrt kind draws SCREENED RRT-Connect paths and returns the one of least Σ‖Δq‖²."""
+    from gdnplan.trajopt import seeds
+
+    problem = Problem.from_toml("planar2_square")
+    request = SeedRequest(problem, problem.goal, problem.margin, 2, 0, 30.0, 2.0)
+    monkeypatch.setattr(seeds, "SCREEN_TIME", 60.0)
+    monkeypatch.setattr(seeds, "SCREENED", 1)
+    first = seeds.rrt_seed(request)
+    monkeypatch.setattr(seeds, "SCREENED", 4)
+    best = seeds.rrt_seed(request)
+    monkeypatch.setattr(seeds, "SCREENED", 1)
+    draws = [seeds.rrt_seed(replace(request, seed=2 + seeds.SCREEN_STRIDE * j)) for j in range(4)]
+    costs = [np.sum(np.diff(d, axis=0) ** 2) for d in draws if d is not None]
+    np.testing.assert_array_equal(draws[0], first)
+    assert np.sum(np.diff(best, axis=0) ** 2) == pytest.approx(min(costs))
+    assert certify_path(problem.scene, best, problem.margin).ok
