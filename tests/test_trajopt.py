@@ -53,7 +53,7 @@ def test_ipopt_solves_planar2_around_a_square_with_coal(square):
 def test_extra_ipopt_options_reach_the_solver(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     cfg = PlanConfig(
-        SeedConfig(starts=1), RefineConfig(ccd=False), IpoptConfig(options={"max_iter": 2})
+        SeedConfig(starts=1, count=1), RefineConfig(ccd=False), IpoptConfig(options={"max_iter": 2})
     )
     result = plan(p, collision="coal", solver=cfg)
     assert result.iterations == 2 and result.status == "Maximum_Iterations_Exceeded"
