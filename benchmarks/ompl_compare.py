@@ -1,17 +1,20 @@
 """gdnplan against OMPL's planners on the Table II problems, one validity rule and one certificate.
 
 Usage: python benchmarks/ompl_compare.py --threads 1 [--envs b d fetch] [--problems N]
-       [--budgets 1 3] [--planners rrtconnect bitstar aorrtc] [--out benchmarks/results/…]
+       [--budgets [1 3]] [--planners rrtconnect bitstar aorrtc] [--seeds N] [--kinds rrt …]
+       [--out benchmarks/results/…]
 
 Problems: the first N of the 20 Table II problems of each setting
 (:func:`gdnplan.table2.reaching_problems`: (b), (d) and the fetch layouts, seed 0).
 Methods, on every problem in one run:
 
-- gdnplan, ``gp.plan(problem)`` with its defaults: coal constraints, and GraphDistNet
-  constraints (the shipped weights of the setting by name, loaded once per setting);
+- gdnplan, ``gp.plan(problem)`` with its defaults (``--seeds`` / ``--kinds`` change the seed
+  count and kinds): coal constraints, and GraphDistNet constraints (the shipped weights of the
+  setting by name, loaded once per setting);
 - OMPL (:func:`gdnplan.ompl_planner.plan_ompl`): each planner + path simplification with each
-  time budget of ``--budgets`` (s) and with "=t", the wall time gdnplan (coal) used on that
-  problem (equal time).
+  time budget of ``--budgets`` (s; none: equal time only) and with "=t", the wall time gdnplan
+  (coal) used on that problem (equal time). A budget is OMPL's whole wall time, simplification
+  included.
 
 Validity is the same for every method: the problem's certified clearance c
 (``Problem.certified_clearance``, the margin) along the whole continuous path. OMPL's states
@@ -40,6 +43,7 @@ import platform
 import shlex
 import sys
 import time
+from dataclasses import replace
 from importlib.metadata import version
 from pathlib import Path
 
@@ -50,6 +54,7 @@ from gdnplan.ccd import certify_path
 from gdnplan.ompl_planner import plan_ompl
 from gdnplan.path_metrics import path_length, resampled_cost
 from gdnplan.table2 import WEIGHTS_ENV, reaching_problems
+from gdnplan.trajopt import plan_config
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "benchmarks" / "results" / "ompl_compare.md"
@@ -90,15 +95,27 @@ def judged(problem, q: np.ndarray, ok: bool) -> dict:
     }
 
 
+def solver(problem, args):
+    """gdnplan's settings: the problem's (the defaults), with ``--seeds`` / ``--kinds``."""
+    cfg = plan_config(problem)
+    seed = cfg.seed
+    if args.seeds is not None:
+        seed = replace(seed, count=args.seeds)
+    if args.kinds is not None:
+        seed = replace(seed, kinds=tuple(args.kinds))
+    return replace(cfg, seed=seed)
+
+
 def run_problem(env: str, i: int, problem, model, args) -> list[dict]:
     """Every method on one problem: one record each."""
     out = []
     for name, collision in (("gdnplan coal", "coal"), ("gdnplan GraphDistNet", model)):
         start = time.perf_counter()
-        r = gp.plan(problem, collision=collision)
+        r = gp.plan(problem, collision=collision, solver=solver(problem, args))
         wall = time.perf_counter() - start
         t = float(getattr(r, "solve_time", wall))
         rec = {"env": env, "problem": i, "method": name, "budget": None, "time": t}
+        rec["seed"] = None if r.seed is None else r.seed.kind
         out.append(rec | judged(problem, np.asarray(r.q), bool(r.success)))
     equal = max(out[0]["time"], 0.05)
     budgets = [(f"{b:g} s", float(b)) for b in args.budgets] + [(EQUAL, equal)]
@@ -150,12 +167,18 @@ def table(records: list[dict]) -> str:
     return "\n".join(lines) + "\n\n" + ratios(records)
 
 
-def _ratio(q: list[float]) -> str:
-    """'median [n] | max | wins/n' of the paired ratios q."""
+def _ratio(q: list[float], lengths: list[float]) -> str:
+    """'median [n] | max | wins/n | median length ratio' of the paired ratios q."""
     if not q:
-        return "– [0] | – | 0/0"
+        return "– [0] | – | 0/0 | –"
     wins = sum(x <= 1.0 for x in q)
-    return f"{np.median(q):.3f} [{len(q)}] | {max(q):.3g} | {wins}/{len(q)}"
+    return (
+        f"{np.median(q):.3f} [{len(q)}] | {max(q):.3g} | {wins}/{len(q)} | {np.median(lengths):.3f}"
+    )
+
+
+def _paired(ours: dict, best: dict, key: str) -> list[float]:
+    return [ours[p][key] / best[p][key] for p in ours if p in best and best[p][key] > 0]
 
 
 def ratios(records: list[dict]) -> str:
@@ -164,25 +187,27 @@ def ratios(records: list[dict]) -> str:
         "Paired cost ratio gdnplan / best OMPL planner at each budget (median over the problems "
         "both solved [n]; ≤ 1: gdnplan is cheaper; wins: problems with ratio ≤ 1):",
         "",
-        "| setting | gdnplan | OMPL budget | median ratio [n] | max ratio | wins |",
-        "|---|---|---|---|---|---|",
+        "| setting | gdnplan | OMPL budget | median ratio [n] | max ratio | wins "
+        "| median length ratio |",
+        "|---|---|---|---|---|---|---|",
     ]
     budgets = [*dict.fromkeys(r["budget"] for r in records if r["budget"]), "any"]
     for env in dict.fromkeys(r["env"] for r in records):
         mine = [r for r in records if r["env"] == env and r["success"]]
         for method in ("gdnplan coal", "gdnplan GraphDistNet"):
-            ours = {r["problem"]: r["cost"] for r in mine if r["method"] == method}
+            ours = {r["problem"]: r for r in mine if r["method"] == method}
             for budget in budgets:
-                best: dict[int, float] = {}
+                best: dict[int, dict] = {}  # the cheapest OMPL path of each problem
                 for r in mine:
                     if r["method"].startswith("OMPL") and budget in (r["budget"], "any"):
-                        best[r["problem"]] = min(best.get(r["problem"], np.inf), r["cost"])
-                q = [ours[p] / best[p] for p in ours if p in best and best[p] > 0]
-                lines.append(f"| {env} | {method} | {budget} | {_ratio(q)} |")
-        coal = {r["problem"]: r["cost"] for r in mine if r["method"] == "gdnplan coal"}
-        gdn = {r["problem"]: r["cost"] for r in mine if r["method"] == "gdnplan GraphDistNet"}
-        q = [gdn[p] / coal[p] for p in gdn if p in coal and coal[p] > 0]
-        lines.append(f"| {env} | GraphDistNet / coal | (gdnplan coal) | {_ratio(q)} |")
+                        if r["cost"] < best.get(r["problem"], {"cost": np.inf})["cost"]:
+                            best[r["problem"]] = r
+                q, lengths = _paired(ours, best, "cost"), _paired(ours, best, "length")
+                lines.append(f"| {env} | {method} | {budget} | {_ratio(q, lengths)} |")
+        coal = {r["problem"]: r for r in mine if r["method"] == "gdnplan coal"}
+        gdn = {r["problem"]: r for r in mine if r["method"] == "gdnplan GraphDistNet"}
+        q, lengths = _paired(gdn, coal, "cost"), _paired(gdn, coal, "length")
+        lines.append(f"| {env} | GraphDistNet / coal | (gdnplan coal) | {_ratio(q, lengths)} |")
     return "\n".join(lines) + "\n"
 
 
@@ -192,8 +217,11 @@ the problem's certified clearance (the margin: 2 cm on (b) and (d), 1 cm on fetc
 as failed unless proven; OMPL's motion validator is gdnplan's edge certificate, so its paths
 are certified as they are built. Cost: Σ‖Δq‖² after resampling to the problem's T waypoints
 (20; fetch 30) equally spaced in joint-space arc length (≈ length² / (T − 1)); medians over the
-successful runs. Budget "=t": the wall time gdnplan with coal constraints used on that problem.
-OMPL's time includes simplification (at most one more budget). Times on a shared CPU.
+successful runs; the length ratio is that of the same pairs (the cheapest OMPL path's length).
+Budget "=t": the wall time gdnplan with coal constraints used on that problem (`Plan.solve_time`:
+seeds, solves, certificates). An OMPL budget is its whole wall time: set-up, planning (80 %
+of the budget for an anytime planner) and simplification in the rest; OMPL's time column
+includes the final certificate. Times on a shared CPU.
 """
 
 
@@ -209,9 +237,11 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=1, help="torch threads")
     parser.add_argument("--envs", nargs="+", default=["b", "d", "fetch"])
     parser.add_argument("--problems", type=int, default=20)
-    parser.add_argument("--budgets", nargs="+", type=float, default=[1.0, 3.0])
+    parser.add_argument("--budgets", nargs="*", type=float, default=[1.0, 3.0])
     parser.add_argument("--planners", nargs="+", default=["rrtconnect", "bitstar", "aorrtc"])
     parser.add_argument("--seed", type=int, default=0, help="OMPL's random seed")
+    parser.add_argument("--seeds", type=int, help="gdnplan's seed count (default: its own)")
+    parser.add_argument("--kinds", nargs="+", help="gdnplan's seed kinds (default: its own)")
     parser.add_argument("--out", type=Path, default=OUT)
     parser.add_argument(
         "--render", type=Path, help="only rewrite --out from this records file (.jsonl)"

@@ -38,6 +38,7 @@ PLANNERS = {  # name -> OMPL geometric planner class
     "rrtstar": "RRTstar",
 }
 MAX_TIME = 600.0  # s, one planning call
+SIMPLIFY_SHARE = 0.2  # share of the time limit kept for path simplification
 _SEEDED: list[int] = []  # OMPL's global seed can be set once per process, before any planner
 
 
@@ -62,7 +63,7 @@ class OmplResult:
         success: OMPL found an exact solution and :func:`gdnplan.ccd.certify_path` proves the
             returned continuous path keeps the proven distance > the clearance.
         path: (K, dof) waypoints (rad), start first, goal last; (0, dof) when OMPL found none.
-        time: wall time of planning and simplification (s).
+        time: wall time of set-up, planning, simplification and the final certificate (s).
         planner: the planner's name (a key of :data:`PLANNERS`).
         status: OMPL's planner status ("Exact solution", "Timeout", …).
         clearance: proven lower bound on the signed distance along the whole path (m, the
@@ -143,15 +144,19 @@ def plan_ompl(
     lower: np.ndarray | None = None,
     upper: np.ndarray | None = None,
 ) -> OmplResult:
-    """Plan start → goal (dof,) with OMPL's ``planner`` within ``time_limit`` (s of planning).
+    """Plan start → goal (dof,) with OMPL's ``planner`` within ``time_limit`` (s of wall time:
+    set-up, planning and simplification together).
 
     ``simplify``: OMPL's ``PathSimplifier`` (vertex reduction, shortcuts, B-spline smoothing,
-    every change checked by the certified motion validator) runs afterwards, with at most
-    ``time_limit`` more seconds; ``OmplResult.time`` includes it. ``lower``/``upper`` (dof,):
-    the joint box (the robot's limits when None). ``seed`` seeds OMPL's generators the first
-    time any planner runs in this process (OMPL allows one global seed); a run is reproducible
-    for the same seed and sequence of calls up to time limits (an anytime planner's result
-    depends on how far it got in its time). Raises InputError on bad input or without OMPL.
+    every change checked by the certified motion validator) runs afterwards in the time left;
+    the planner then gets (1 − ``SIMPLIFY_SHARE``) of ``time_limit`` (an anytime planner uses
+    all of it, RRT-Connect stops at its first path and leaves the rest to simplification).
+    ``OmplResult.time`` is the whole wall time (the final certificate included).
+    ``lower``/``upper`` (dof,): the joint box (the robot's limits when None). ``seed`` seeds
+    OMPL's generators the first time any planner runs in this process (OMPL allows one global
+    seed); a run is reproducible for the same seed and sequence of calls up to time limits (an
+    anytime planner's result depends on how far it got in its time). Raises InputError on bad
+    input or without OMPL.
     """
     start, goal, lower, upper = _check(
         scene, start, goal, lower, upper, clearance, time_limit, planner
@@ -168,19 +173,20 @@ def plan_ompl(
     ss.setStartAndGoalStates(a, b)
     ss.setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
     ss.setPlanner(getattr(og, PLANNERS[planner])(si))
-    status = str(ss.solve(float(time_limit)))
+    share = 1.0 - SIMPLIFY_SHARE if simplify else 1.0
+    status = str(ss.solve(max(share * float(time_limit) - (time.perf_counter() - t0), 1e-3)))
     dof = scene.robot.dof
     if not ss.haveExactSolutionPath():
         return OmplResult(
             False, np.zeros((0, dof)), time.perf_counter() - t0, planner, status, -math.inf, None
         )
     if simplify:
-        ss.simplifySolution(float(time_limit))
+        ss.simplifySolution(max(float(time_limit) - (time.perf_counter() - t0), 1e-3))
     sol = ss.getSolutionPath()
     path = np.array([vector(sol.getState(i)) for i in range(sol.getStateCount())])
     path[0], path[-1] = start, goal  # OMPL's goal test is exact for a state goal
-    elapsed = time.perf_counter() - t0
     cert = certify(scene, path, margin=clearance)
+    elapsed = time.perf_counter() - t0
     return OmplResult(cert.ok, path, elapsed, planner, status, cert.lower_bound, cert)
 
 

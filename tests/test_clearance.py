@@ -1,6 +1,8 @@
 """The margin is a promise (#22): a successful plan is proven to keep its requested clearance
 (the margin unless ``[options] clearance`` asks for less) along the whole continuous path."""
 
+import functools
+import itertools
 import math
 import time
 
@@ -25,6 +27,7 @@ def _check_kept(problem: Problem, result) -> None:
     assert result.min_distance > problem.margin  # the proven bound, not bound − margin
     cert = certify(problem.scene, result.q, problem.margin)
     assert cert.ok and cert.lower_bound > problem.margin
+    check_promise(problem, result)  # and dense coal samples agree
 
 
 @pytest.mark.parametrize(
@@ -100,3 +103,63 @@ def test_without_a_buffer_the_refine_rounds_still_never_accept_less_than_the_mar
     cert = certify(problem.scene, result.q, problem.margin)
     assert cert.ok == result.success
     assert np.all(result.q[[0, -1]] == [problem.start, problem.goal])
+
+
+def dense_min_distance(scene, q: np.ndarray, per_segment: int = 200) -> float:
+    """Smallest coal signed distance at ``per_segment`` evenly spaced points of every segment
+    of the path q (T, dof), ends included: an independent upper bound of the path's minimum
+    (the certificate's proven bound must lie below it)."""
+    s = np.linspace(0.0, 1.0, per_segment + 1)[:, None]
+    points = np.concatenate([a + s * (b - a) for a, b in itertools.pairwise(q)])
+    return float(np.min(gp.signed_distance(scene, points)))
+
+
+def check_promise(problem: Problem, result) -> None:
+    """A successful plan proves d > its requested clearance on the whole path: the Plan's bound,
+    the certificate run again, and dense coal samples all say so (failures are allowed)."""
+    if not result.success:
+        return
+    c = problem.certified_clearance
+    assert result.clearance == c
+    assert result.min_distance > c  # the proven bound the Plan reports
+    cert = certify(problem.scene, result.q, c)
+    assert cert.ok and cert.lower_bound > c
+    dense = dense_min_distance(problem.scene, result.q)
+    assert dense > c  # independent of the certificate
+    assert result.min_distance <= dense + 1e-9  # a lower bound is below every sample
+
+
+@functools.cache
+def table2_problems(setting: str, n: int) -> tuple:
+    from gdnplan.table2 import reaching_problems
+
+    return tuple(reaching_problems(setting, n=n))
+
+
+@functools.cache
+def table2_model(setting: str, collision: str):
+    from gdnplan.table2 import WEIGHTS_ENV
+
+    return "coal" if collision == "coal" else gp.load_model(WEIGHTS_ENV[setting])
+
+
+@pytest.mark.parametrize(
+    ("setting", "collision", "n"),
+    [("b", "coal", 2), ("b", "graphdistnet", 1)]
+    + [
+        pytest.param(s, c, 20, marks=pytest.mark.slow)  # minutes each
+        for s in ("b", "d", "fetch")
+        for c in ("coal", "graphdistnet")
+    ],
+)
+def test_table2_plans_keep_their_margin(setting, collision, n):
+    """Table II's problems (its margins: 2 cm on (b) and (d), 1 cm on fetch), planned with the
+    defaults: every success keeps the margin along the whole path, and most succeed."""
+    problems = table2_problems(setting, n)
+    model = table2_model(setting, collision)
+    solved = 0
+    for problem in problems:
+        result = plan(problem, collision=model)
+        check_promise(problem, result)
+        solved += result.success
+    assert solved >= 0.9 * len(problems)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -49,7 +50,7 @@ def random_problem(scene_seed: int, q_seed: int) -> Problem:
 @given(scene_seed=st.integers(0, 10_000), q_seed=st.integers(0, 10_000), seed=st.integers(0, 50))
 def test_more_seeds_never_return_a_costlier_certified_plan(scene_seed, q_seed, seed):
     problem = random_problem(scene_seed, q_seed)
-    one = plan(problem, collision="coal", seed=seed)
+    one = plan(problem, collision="coal", solver=PlanConfig(seed=SeedConfig(count=1)), seed=seed)
     cfg = PlanConfig(seed=SeedConfig(count=3))
     three = plan(problem, collision="coal", solver=cfg, seed=seed)
     for result in (one, three):
@@ -72,7 +73,8 @@ def test_several_seeds_are_deterministic_and_report_the_winner():
     assert a.seed == b.seed and a.attempts == b.attempts == 4
     assert a.seed.kind == "rrt" and "least path cost of 4 certified" in a.reason
     assert_certified(problem, a)
-    single = plan(problem, collision="coal", seed=5)  # the first of the four seeds
+    one = PlanConfig(seed=SeedConfig(count=1))
+    single = plan(problem, collision="coal", solver=one, seed=5)  # the first of the four seeds
     assert a.path_cost <= single.path_cost + 1e-12
 
 
@@ -122,23 +124,86 @@ def test_a_seed_kind_of_the_wrong_shape_is_an_input_error(monkeypatch):
         plan(problem, collision="coal", solver=PlanConfig(seed=SeedConfig(kinds=("short",))))
 
 
-@pytest.mark.slow
-def test_the_time_budget_is_kept_within_one_solve():
-    """Anytime mode: seeds until the budget ends, the cheapest certified path found by then.
-    Bound: the budget plus one single-seed plan's time (Ipopt is cut at the time left, so at
-    most one iteration, one certificate and one NLP build run past it) plus 1 s of scheduling
-    slack on a shared machine — a loose bound, not a timing measurement."""
-    problem = Problem.from_toml("planar7_d")
-    single = plan(problem, collision="coal")
-    budget = 2.0
-    cfg = PlanConfig(seed=SeedConfig(time_budget=budget))
-    result = plan(problem, collision="coal", solver=cfg)
-    assert result.solve_time <= budget + single.solve_time + 1.0
-    if result.success:
-        assert_certified(problem, result)
-        assert result.attempts >= 1
-    else:
-        assert "time budget" in result.reason
+class FakeClock:
+    """A ``time`` module stand-in for the planner: ``perf_counter`` advances 1 µs a call, and
+    ``step`` seconds whenever :meth:`tick` (a seed kind's work) runs."""
+
+    def __init__(self) -> None:
+        self.now = 1000.0
+
+    def perf_counter(self) -> float:
+        self.now += 1e-6
+        return self.now
+
+    def tick(self, seconds: float) -> None:
+        self.now += seconds
+
+
+@pytest.fixture
+def fake_clock(monkeypatch) -> FakeClock:
+    """The planner's clock (``time`` in plan, seeds, solves and the result) is a FakeClock."""
+    from gdnplan.trajopt import ipopt, planner, result, seeds
+
+    clock = FakeClock()
+    for module in (planner, seeds, ipopt, result):
+        monkeypatch.setattr(module, "time", clock)
+    return clock
+
+
+def test_the_time_budget_is_kept_within_one_solve(fake_clock, monkeypatch):
+    """Anytime mode on an injected clock: each seed takes 10 s, the budget is 25 s, so seeds 0
+    and 1 are refined and certified, seed 2 is drawn (the clock then says 30 s) but no solve
+    starts after the deadline, and the cheaper of the two certified paths comes back; the
+    call's time is the clock's (Ipopt's own wall-time cap, the time left, is ≥ 5 s real)."""
+    streams = []
+
+    def slow_arc(request: SeedRequest):
+        streams.append(request.stream)
+        fake_clock.tick(10.0)
+        p = request.problem
+        guess = straight_line(p.start, request.goal, p.waypoints)
+        bend = (1.5 - 0.3 * request.index) * np.sin(np.linspace(0, np.pi, p.waypoints))[1:-1]
+        guess[1:-1, 1] += bend
+        return np.clip(guess, p.lower, p.upper)
+
+    monkeypatch.setitem(SEED_KINDS, "slow", slow_arc)
+    problem = Problem.from_toml("planar2_square")
+    cfg = PlanConfig(seed=SeedConfig(initial="rrt", kinds=("slow",), time_budget=25.0))
+    result = plan(problem, collision="coal", solver=cfg, seed=7)
+    assert streams == [7, 8, 9]  # the third seed was drawn before the deadline
+    assert result.attempts == 3
+    assert result.success and result.seed.index in (0, 1)
+    assert_certified(problem, result)
+    assert "least path cost of 2 certified" in result.reason
+    assert 30.0 <= result.solve_time < 30.1  # the clock's seconds, not the machine's
+    unbudgeted = plan(problem, collision="coal", solver=PlanConfig(seed=SeedConfig(
+        initial="rrt", kinds=("slow",), count=2)), seed=7)  # fmt: skip
+    assert unbudgeted.attempts == 2 and 20.0 <= unbudgeted.solve_time < 20.1
+
+
+def test_failed_seeds_draw_new_ones_within_the_budget(fake_clock, monkeypatch):
+    """Within a time budget a seed that finds no path does not end the call after ``starts``
+    failures: the next seed is drawn until the budget ends (here 5 failures, then a path; a
+    seed that finds none is asked once more at the margin alone, so a failure costs 1 s)."""
+
+    def sometimes(request: SeedRequest):
+        fake_clock.tick(0.5)
+        if request.index < 5:
+            return None
+        p = request.problem
+        guess = straight_line(p.start, request.goal, p.waypoints)
+        guess[1:-1, 1] += 1.5 * np.sin(np.linspace(0, np.pi, p.waypoints))[1:-1]
+        return np.clip(guess, p.lower, p.upper)
+
+    monkeypatch.setitem(SEED_KINDS, "sometimes", sometimes)
+    problem = Problem.from_toml("planar2_square")
+    seeds = SeedConfig(initial="rrt", kinds=("sometimes",), starts=2, time_budget=6.5)
+    result = plan(problem, collision="coal", solver=PlanConfig(seed=seeds))
+    assert result.success and result.seed.index == 5, result.reason
+    assert_certified(problem, result)
+    unbudgeted = PlanConfig(seed=replace(seeds, time_budget=None))
+    without = plan(problem, collision="coal", solver=unbudgeted)
+    assert not without.success and without.attempts == 2  # starts = 2 failures end it
 
 
 def test_a_budget_too_short_for_any_seed_fails_instead_of_returning_an_uncertified_path():
@@ -179,3 +244,41 @@ def test_plan_flags_that_do_not_apply_are_input_errors(args, message, capsys):
     code, _, err = cli(["plan", "planar2_square", "--collision", "coal", "-q", *args], capsys)
     assert code == 2 and err.count("\n") == 1
     assert err.startswith("error: ") and message in err, err
+
+
+def test_an_aorrtc_seed_is_refined_and_certified():
+    pytest.importorskip("ompl")
+    problem = Problem.from_toml("planar2_square")
+    cfg = PlanConfig(seed=SeedConfig(kinds=("aorrtc",), count=1))
+    result = plan(problem, collision="coal", solver=cfg)
+    assert result.success, result.reason
+    assert result.seed.kind == "aorrtc"
+    assert_certified(problem, result)
+
+
+def test_a_seed_kind_whose_dependency_is_missing_says_how_to_install_it(monkeypatch):
+    from gdnplan.trajopt.config import MISSING_SEED_KINDS
+
+    monkeypatch.delitem(SEED_KINDS, "aorrtc", raising=False)
+    monkeypatch.setitem(MISSING_SEED_KINDS, "aorrtc", "needs OMPL, which is not installed (…)")
+    with pytest.raises(gp.InputError, match="kinds: seed kind 'aorrtc' needs OMPL"):
+        SeedConfig(kinds=("rrt", "aorrtc"))
+
+
+def test_an_rrt_seed_is_the_cheapest_of_its_draws(monkeypatch):
+    """The rrt kind draws SCREENED RRT-Connect paths and returns the one of least Σ‖Δq‖²."""
+    from gdnplan.trajopt import seeds
+
+    problem = Problem.from_toml("planar2_square")
+    request = SeedRequest(problem, problem.goal, problem.margin, 2, 0, 30.0, 2.0)
+    monkeypatch.setattr(seeds, "SCREEN_TIME", 60.0)
+    monkeypatch.setattr(seeds, "SCREENED", 1)
+    first = seeds.rrt_seed(request)
+    monkeypatch.setattr(seeds, "SCREENED", 4)
+    best = seeds.rrt_seed(request)
+    monkeypatch.setattr(seeds, "SCREENED", 1)
+    draws = [seeds.rrt_seed(replace(request, seed=2 + seeds.SCREEN_STRIDE * j)) for j in range(4)]
+    costs = [np.sum(np.diff(d, axis=0) ** 2) for d in draws if d is not None]
+    np.testing.assert_array_equal(draws[0], first)
+    assert np.sum(np.diff(best, axis=0) ** 2) == pytest.approx(min(costs))
+    assert certify_path(problem.scene, best, problem.margin).ok

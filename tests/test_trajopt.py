@@ -53,7 +53,7 @@ def test_ipopt_solves_planar2_around_a_square_with_coal(square):
 def test_extra_ipopt_options_reach_the_solver(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     cfg = PlanConfig(
-        SeedConfig(starts=1), RefineConfig(ccd=False), IpoptConfig(options={"max_iter": 2})
+        SeedConfig(starts=1, count=1), RefineConfig(ccd=False), IpoptConfig(options={"max_iter": 2})
     )
     result = plan(p, collision="coal", solver=cfg)
     assert result.iterations == 2 and result.status == "Maximum_Iterations_Exceeded"
@@ -344,7 +344,8 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
 
     monkeypatch.setattr(trajopt._Transcription, "__init__", record)
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
-    opts = PlanConfig(SeedConfig(initial="rrt", starts=1), RefineConfig(rounds=1, raise_window=1))
+    refine = RefineConfig(rounds=1, raise_window=1, exact_rows=False)
+    opts = PlanConfig(SeedConfig(initial="rrt", starts=1), refine)
     assert not plan(p, collision=_Liar(), solver=opts).success
     (_, first), (splits, second) = margins
     base = trajopt.check_points.constraint_margin(
@@ -372,9 +373,10 @@ def test_refine_rounds_raise_to_the_overestimate_not_its_sum(square, monkeypatch
 
     monkeypatch.setattr(trajopt._Transcription, "__init__", record)
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
-    opts = TrajoptOptions(initial="rrt", refine_rounds=2, starts=1, raise_window=None)
-    assert not plan(p, collision=_Liar(), options=opts).success
-    base = trajopt.check_points.constraint_margin(p, opts.clearance_buffer)
+    refine = RefineConfig(rounds=2, raise_window=None, exact_rows=False)
+    opts = PlanConfig(SeedConfig(initial="rrt", starts=1), refine)
+    assert not plan(p, collision=_Liar(), solver=opts).success
+    base = trajopt.check_points.constraint_margin(p, refine.clearance_buffer)
     assert len(margins) == 3
     assert 0.9 < np.max(margins[1] - base) < 1.5
     assert 0.9 < np.max(margins[2] - base) < 1.5

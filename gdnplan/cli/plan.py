@@ -74,7 +74,7 @@ def plan_command(
     seeds: int = typer.Option(
         None,
         help="Seed paths refined (Ipopt), the cheapest certified path returned; default: the "
-        "file's [seed] count, else 1 (with --time-budget: as many as fit).",
+        "file's [seed] count, else 3 (with --time-budget: as many as fit).",
     ),
     time_budget: float = typer.Option(
         None,

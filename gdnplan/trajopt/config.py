@@ -44,6 +44,9 @@ INITIAL_GUESSES = ("auto", "straight", "rrt")
 # seed kind name -> function SeedRequest -> (T, dof) path or None; filled by
 # gdnplan.trajopt.seeds (the shipped kinds) and seeds.register_seed_kind
 SEED_KINDS: dict[str, Callable] = {}
+MISSING_SEED_KINDS: dict[str, str] = {}  # kind name -> why it is not available (its dependency)
+# the default: three RRT-Connect seeds (docs/decisions.md#seeds-within-one-call-margin-helper)
+DEFAULT_SEEDS = 3
 
 
 def _check_bools(cfg, names: tuple[str, ...]) -> None:
@@ -61,11 +64,12 @@ class SeedConfig:
             "straight" (the straight line, perturbed by N(0, 0.2 rad) for later seeds) or
             "rrt" (always seed paths).
         count: seed paths refined; the certified path of least path cost Σ‖Δq‖² among them
-            is returned. None: 1 without ``time_budget``; with one, seeds until it ends
-            (at most ``limits.MAX_SEEDS``).
+            is returned. None: ``DEFAULT_SEEDS`` (3) without ``time_budget``; with one, seeds
+            until it ends (at most ``limits.MAX_SEEDS``).
         kinds: the seed kinds drawn in turn (seed i is of kind ``kinds[i % len(kinds)]``):
             names of :data:`gdnplan.trajopt.seeds.SEED_KINDS` ("rrt": RRT-Connect;
-            "via": RRT-Connect through a random free via point, often another homotopy class).
+            "via": RRT-Connect through a random free via point, often another homotopy class;
+            "aorrtc": OMPL's AORRTC, with OMPL installed).
         starts: attempts of the first seed: an attempt whose path ends uncertified is
             replaced by a new seed, at most ``starts − 1`` times over the whole call.
         time_budget: wall time (s) of the whole call; when it ends, the best certified path
@@ -98,6 +102,8 @@ class SeedConfig:
         if not isinstance(self.kinds, tuple) or not self.kinds:
             raise InputError(f"kinds: expected a list of seed kind names, got {self.kinds!r}")
         for kind in self.kinds:
+            if isinstance(kind, str) and kind in MISSING_SEED_KINDS:
+                raise InputError(f"kinds: seed kind {kind!r} {MISSING_SEED_KINDS[kind]}")
             if not isinstance(kind, str) or kind not in SEED_KINDS:
                 raise InputError(
                     f"kinds: unknown seed kind {kind!r}; choose from {list(SEED_KINDS)}"
@@ -118,7 +124,7 @@ class SeedConfig:
         """The number of seeds to refine: ``count``, or its automatic value."""
         if self.count is not None:
             return self.count
-        return 1 if self.time_budget is None else MAX_SEEDS
+        return DEFAULT_SEEDS if self.time_budget is None else MAX_SEEDS
 
 
 @dataclass(frozen=True)
@@ -137,7 +143,11 @@ class RefineConfig:
             buffer leaves the path room to bend between check points.
         raise_window: (Ipopt, learned models) a refine round raises the model's margin on the
             rejected segments and this many segments either side of each; None: on the
-            whole path (docs/decisions.md#raise-window).
+            whole path (docs/decisions.md#raise-window). With ``exact_rows``: the segments
+            that get coal rows.
+        exact_rows: (Ipopt, learned models) a refine round constrains the check points of
+            those segments by coal's exact distance instead of the model's raised bound
+            (:mod:`gdnplan.trajopt.refine`).
     """
 
     ccd: bool = True
@@ -145,9 +155,10 @@ class RefineConfig:
     warm_start: bool = True
     clearance_buffer: float = 0.002
     raise_window: int | None = 2
+    exact_rows: bool = True
 
     def __post_init__(self) -> None:
-        _check_bools(self, ("ccd", "warm_start"))
+        _check_bools(self, ("ccd", "warm_start", "exact_rows"))
         check_int(self.rounds, "rounds", 0, MAX_REFINE_ROUNDS)
         check_number(self.clearance_buffer, "clearance_buffer")
         if self.raise_window is not None:

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..casadi_bridge import supports_per_link
 from ..exact import certify, exact_distance
+from ..limits import MAX_SEEDS
 from ..models import DistanceModel
 from .check_points import (
     _check_point_raise,
@@ -24,6 +25,7 @@ from .check_points import (
 )
 from .config import PlanConfig
 from .problem import Problem
+from .refine import with_exact_rows
 from .result import _Run, path_cost
 from .seeds import SeedInfo, draw_seed
 from .transcription import _Transcription
@@ -70,7 +72,8 @@ def _plan_ipopt(
     """Straight line when certified free, else Ipopt from each seed; the cheapest certified.
 
     Seeds i = 0, 1, … (kind ``kinds[i % len(kinds)]``, stream seed + i) are refined until
-    ``seed_count`` are certified, ``starts`` have ended uncertified, or the clock passes
+    ``seed_count`` are certified, ``starts`` have ended uncertified (without a time budget;
+    within one, a failed seed draws the next until the budget ends), or the clock passes
     ``deadline``. An attempt that ends uncertified suggests check points too sparse for the
     problem, so after f such attempts a seed starts with ``interpolated + min(f, starts − 1)``
     check points per segment (on one (d) problem, #14, all three attempts with 2 check points
@@ -85,8 +88,9 @@ def _plan_ipopt(
     clearance = _seed_clearance(problem, goal, sc.rrt_clearance)
     run, best, failures = _Run(q=line), _Best(), 0
     first, wanted = cfg.optimizer.interpolated, sc.seed_count
-    for index in range(wanted + sc.starts - 1):
-        if best.certified == wanted or failures == sc.starts:
+    budgeted = math.isfinite(deadline)
+    for index in range(wanted + (MAX_SEEDS if budgeted else sc.starts - 1)):
+        if best.certified == wanted or (failures == sc.starts and not budgeted):
             break
         if time.perf_counter() >= deadline:
             run.reason = f"{run.reason}; time budget ended".lstrip("; ")
@@ -139,8 +143,10 @@ def _solve_refined(
     clearance + ``clearance_buffer`` if that is more); the certificate must prove
     d > ``problem.certified_clearance`` on the whole continuous path.
     Each round that the coal certificate rejects doubles the check points of the rejected
-    segments and, for a learned model, raises the constraint margin to the model's observed
-    overestimate there (:func:`model_overestimate`) on the rejected segments and
+    segments and, for a learned model, gives the check points of the rejected segments and
+    ``raise_window`` segments either side coal rows (``RefineConfig.exact_rows``,
+    :mod:`gdnplan.trajopt.refine`); without exact rows it raises the constraint margin to the
+    model's observed overestimate there (:func:`model_overestimate`) on the rejected segments and
     ``raise_window`` segments either side: the learned constraint then keeps the path away
     from the contact coal found, whatever the model's error (on the rejected segments alone
     the contact moved to the neighbouring segments; on the whole path a narrow passage
@@ -154,8 +160,10 @@ def _solve_refined(
     per_link = supports_per_link(model) if ipopt.per_link is None else ipopt.per_link
     ipopt = replace(ipopt, per_link=per_link)
     learned = not is_exact(model)
+    exact_rows = learned and refine.exact_rows and not per_link
     margin = constraint_margin(problem, refine.clearance_buffer)  # above the certified clearance
     raised = np.zeros(len(splits))  # margin raise of each segment (m)
+    exact = np.zeros(len(splits), bool)  # segments whose check points have coal rows
     q, duals, stats = guess, None, {"return_status": "time budget ended"}
     for round_ in range(1 + (refine.rounds if refine.ccd else 0)):
         t0 = time.perf_counter()
@@ -165,8 +173,8 @@ def _solve_refined(
             left = min(max(deadline - t0, 1e-3), ipopt.options.get("max_wall_time", math.inf))
             ipopt = replace(ipopt, options={**ipopt.options, "max_wall_time": left})
         nlp = _Transcription(
-            problem, model, goal, ipopt, splits, margin + _check_point_raise(splits, raised),
-            duals is not None,
+            problem, with_exact_rows(model, splits, exact), goal, ipopt, splits,
+            margin + _check_point_raise(splits, raised), duals is not None,
         )  # fmt: skip
         q, stats = nlp.solve(q, duals)
         run.iterations += stats.get("iter_count", 0)
@@ -187,8 +195,10 @@ def _solve_refined(
         refined[bad] *= 2
         duals = nlp.duals_on(refined) if refine.warm_start else None
         splits = refined
-        if learned:
-            over = model_overestimate(problem.scene, model, q, bad, margin)
-            near = _near_segments(bad, len(splits), refine.raise_window)  # active rows sit at
+        near = _near_segments(bad, len(splits), refine.raise_window)
+        if exact_rows:  # coal rows there (gdnplan.trajopt.refine): the true distance, no raise
+            exact[near] = True
+        elif learned:
+            over = model_overestimate(problem.scene, model, q, bad, margin)  # active rows sit at
             raised[near] = np.maximum(raised[near], over)  # d̂ = bound: raise to the error, no sum
     return q, stats, False

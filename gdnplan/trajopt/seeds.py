@@ -17,19 +17,26 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from importlib.util import find_spec
 
 import numpy as np
 
 from ..errors import InputError
 from ..exact import exact_distance
+from ..path_metrics import resample_arc_length
 from ..rrt import resample, rrt_connect, seed_path, shortcut
 from .check_points import straight_line
-from .config import SEED_KINDS
+from .config import MISSING_SEED_KINDS, SEED_KINDS
 from .problem import Problem
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
 VIA_DRAWS = 100  # random via points drawn until one clears the demanded clearance
+SCREENED = 4  # RRT-Connect paths drawn per rrt seed; the cheapest is refined (decisions.md)
+SCREEN_TIME = 1.0  # s: the draws after the first share this
+SCREEN_STRIDE = 100_003  # stream offset of draw j (far from the streams of other seeds)
+OMPL_TIME = 1.0  # s: planning + simplification of one OMPL seed (docs/decisions.md)
+HAS_OMPL = find_spec("ompl") is not None
 
 
 @dataclass(frozen=True)
@@ -76,19 +83,35 @@ class SeedInfo:
 
 
 def rrt_seed(request: SeedRequest) -> np.ndarray | None:
-    """RRT-Connect + shortcut + resample (:func:`gdnplan.rrt.seed_path`) on ``request.stream``."""
+    """The cheapest of up to ``SCREENED`` RRT-Connect + shortcut + resample paths
+    (:func:`gdnplan.rrt.seed_path`; path j on stream ``request.stream + SCREEN_STRIDE · j``,
+    path 0 on ``request.stream`` itself) by path cost Σ‖Δq‖²: RRT-Connect's paths fall into
+    different homotopy classes, and refining the cheapest draw is far cheaper than refining
+    each. Paths after the first share ``SCREEN_TIME`` s (and ``request.time_limit``)."""
     p = request.problem
-    path, _ = seed_path(
-        p.scene,
-        p.start,
-        request.goal,
-        p.waypoints,
-        request.clearance,
-        seed=request.stream,
-        time_limit=request.time_limit,
-        step=request.rrt_step,
-    )
-    return path
+    t0, best, best_cost = time.perf_counter(), None, math.inf
+    first = t0  # when the first draw ended
+    for j in range(SCREENED):
+        left = request.time_limit - (time.perf_counter() - t0)
+        if j:
+            left = min(left, SCREEN_TIME - (time.perf_counter() - first))
+        if left <= 0:
+            break
+        path, _ = seed_path(
+            p.scene,
+            p.start,
+            request.goal,
+            p.waypoints,
+            request.clearance,
+            seed=request.stream + SCREEN_STRIDE * j,
+            time_limit=left,
+            step=request.rrt_step,
+        )
+        if j == 0:
+            first = time.perf_counter()
+        if path is not None and (cost := float(np.sum(np.diff(path, axis=0) ** 2))) < best_cost:
+            best, best_cost = path, cost
+    return best
 
 
 def via_seed(request: SeedRequest) -> np.ndarray | None:
@@ -140,7 +163,37 @@ def straight_seed(request: SeedRequest) -> np.ndarray:
     return guess
 
 
+def aorrtc_seed(request: SeedRequest) -> np.ndarray | None:
+    """OMPL's asymptotically optimal AORRTC under the path-length objective, simplified
+    (:func:`gdnplan.ompl_planner.plan_ompl`), its states and motions certified above the
+    smaller of ``request.clearance`` and the margin (the shortest way may pass where only the
+    margin fits), within ``OMPL_TIME`` s of planning and simplification; resampled to T
+    waypoints equally spaced in joint-space arc length
+    (:func:`gdnplan.path_metrics.resample_arc_length`: on a fixed polyline, the spacing of
+    least Σ‖Δq‖²). OMPL seeds its generator once per process, so ``request.stream`` does not
+    pick its run (not reproducible). Needs OMPL (``pip install 'gdnplan[bench]'``)."""
+
+    from ..ompl_planner import plan_ompl
+
+    p = request.problem
+    budget = min(request.time_limit, OMPL_TIME)
+    clearance = min(request.clearance, p.margin)  # not more: the short way may be narrow
+    r = plan_ompl(
+        p.scene, p.start, request.goal, clearance, "aorrtc", budget,
+        seed=request.stream, lower=p.lower, upper=p.upper,
+    )  # fmt: skip
+    if not r.success:
+        return None
+    return resample_arc_length(r.path, p.waypoints)
+
+
 SEED_KINDS.update(rrt=rrt_seed, via=via_seed, straight=straight_seed)
+if HAS_OMPL:
+    SEED_KINDS["aorrtc"] = aorrtc_seed
+else:
+    MISSING_SEED_KINDS["aorrtc"] = (
+        "needs OMPL, which is not installed (pip install 'gdnplan[bench]')"
+    )
 
 
 def register_seed_kind(name: str, source: SeedSource) -> None:
@@ -195,6 +248,7 @@ __all__ = [
     "SeedInfo",
     "SeedRequest",
     "SeedSource",
+    "aorrtc_seed",
     "draw_seed",
     "register_seed_kind",
     "rrt_seed",

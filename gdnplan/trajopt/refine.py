@@ -1,0 +1,101 @@
+"""Exact rows for refine rounds of a learned model: where the coal certificate rejected a
+segment, the check points there are constrained by coal's signed distance instead of the model.
+
+A learned model d̂ overestimates the distance somewhere, and the certificate then rejects the
+segments where the true distance d drops below the certified clearance. Raising the model's
+bound there by its observed error (d̂ − d) keeps the path away, but the error measured at one
+path is not the error after the path moves, and a raised bound pushes the whole neighbourhood
+out (a detour). Exact rows replace, at the check points of the rejected segments (and
+``raise_window`` segments either side), the row d̂(p_k) ≥ b_k by d_coal(p_k) ≥ b_k: the bound
+needs no raise there and is the true distance wherever the path moves; the other check points
+keep the learned model. Coal's gradient is its closest-pair witness gradient
+(:func:`gdnplan.distance.signed_distance_and_grad`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..distance import signed_distance, signed_distance_and_grad
+from ..models import DistanceModel
+from ..scene import Scene
+from .check_points import _check_point_raise
+
+
+def exact_check_points(splits: np.ndarray, exact: np.ndarray) -> np.ndarray:
+    """(K,) bool: the inner check points of ``splits`` (the NLP's distance rows) lying on a
+    segment marked in ``exact`` (T − 1,) bool; a waypoint between two segments is exact when
+    either is."""
+    return _check_point_raise(splits, exact.astype(float)) > 0
+
+
+class ExactRows:
+    """A :class:`~gdnplan.models.DistanceModel` for the NLP's check points: coal at the batch
+    positions ``exact`` (K,) bool, ``model`` at the others.
+
+    Only a batch of K configurations (the check points, in order) is split; any other batch
+    goes to ``model`` alone. Keeps ``model``'s deferred gradient
+    (``distance_deferred_grad``) when it has one.
+    """
+
+    def __init__(self, model: DistanceModel, exact: np.ndarray) -> None:
+        self.model, self.exact = model, np.asarray(exact, bool)
+        self.name = f"{model.name} + coal rows"
+        if hasattr(model, "distance_deferred_grad"):
+            self.distance_deferred_grad = self._deferred
+
+    def _mask(self, q: np.ndarray) -> np.ndarray:
+        return self.exact if len(q) == len(self.exact) else np.zeros(len(q), bool)
+
+    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        q = np.atleast_2d(q)
+        m = self._mask(q)
+        d = np.empty(len(q))
+        if (~m).any():
+            d[~m] = self.model.distance(scene, q[~m])
+        if m.any():
+            d[m] = signed_distance(scene, q[m])
+        return d
+
+    def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        q = np.atleast_2d(q)
+        m = self._mask(q)
+        d, g = np.empty(len(q)), np.empty(q.shape)
+        if (~m).any():
+            d[~m], g[~m] = self.model.distance_and_grad(scene, q[~m])
+        if m.any():
+            d[m], g[m] = signed_distance_and_grad(scene, q[m])
+        return d, g
+
+    def _deferred(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
+        q = np.atleast_2d(q)
+        m = self._mask(q)
+        d, g_exact = np.empty(len(q)), None
+        learned = None
+        if (~m).any():
+            d[~m], learned = self.model.distance_deferred_grad(scene, q[~m])
+        if m.any():
+            d[m], g_exact = signed_distance_and_grad(scene, q[m])
+
+        def grad() -> np.ndarray:
+            g = np.empty(q.shape)
+            if learned is not None:
+                g[~m] = learned()
+            if g_exact is not None:
+                g[m] = g_exact
+            return g
+
+        return d, grad
+
+
+def with_exact_rows(model: DistanceModel, splits: np.ndarray, exact: np.ndarray) -> DistanceModel:
+    """``model`` with coal rows at the check points of the segments ``exact`` (T − 1,) bool
+    (:class:`ExactRows`); ``model`` itself when no segment is marked."""
+    if not exact.any():
+        return model
+    return ExactRows(model, exact_check_points(splits, exact))
+
+
+__all__ = ["ExactRows", "exact_check_points", "with_exact_rows"]

@@ -1,0 +1,86 @@
+"""Exact coal rows in refine rounds of a learned model (gdnplan.trajopt.refine)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import gdnplan as gp
+from gdnplan.ccd import certify_path
+from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
+from gdnplan.trajopt.check_points import _check_point_raise, _path_parameters
+from gdnplan.trajopt.refine import ExactRows, exact_check_points, with_exact_rows
+
+START, GOAL = [1.3, -2.9], [1.5, 0.1]  # planar2 around env a's square; the straight line hits it
+
+
+@pytest.fixture(scope="module")
+def square():
+    return gp.make_scene("a")
+
+
+class Liar:
+    """Claims 1 m of clearance everywhere with a zero gradient: every path looks free."""
+
+    name = "liar"
+
+    def distance(self, scene, q):
+        return np.ones(len(np.atleast_2d(q)))
+
+    def distance_and_grad(self, scene, q):
+        q = np.atleast_2d(q)
+        return np.ones(len(q)), np.zeros_like(q)
+
+
+class DeferredLiar(Liar):
+    def distance_deferred_grad(self, scene, q):
+        q = np.atleast_2d(q)
+        return np.ones(len(q)), lambda: np.full(q.shape, 7.0)
+
+
+def test_exact_check_points_are_those_of_the_marked_segments():
+    splits = np.array([2, 4, 2, 2, 2])
+    exact = np.array([False, False, True, False, True])
+    mask = exact_check_points(splits, exact)
+    s = _path_parameters(splits)[1:-1]  # inner check points, 0 < s < 5
+    expected = ((s >= 2) & (s <= 3)) | (s >= 4)  # a waypoint is exact when a neighbour is
+    assert mask.tolist() == expected.tolist()
+    assert mask.tolist() == (_check_point_raise(splits, exact.astype(float)) > 0).tolist()
+
+
+@pytest.mark.parametrize("model", [Liar(), DeferredLiar()], ids=["plain", "deferred"])
+def test_exact_rows_are_coal_at_their_check_points_and_the_model_elsewhere(square, model):
+    q = square.robot.sample(9, seed=3)
+    mask = np.array([True, False, False, True, True, False, True, False, False])
+    mixed = ExactRows(model, mask)
+    d_coal, g_coal = gp.signed_distance_and_grad(square, q)
+    d, g = mixed.distance_and_grad(square, q)
+    np.testing.assert_allclose(d[mask], d_coal[mask])
+    np.testing.assert_allclose(g[mask], g_coal[mask])
+    assert np.all(d[~mask] == 1.0) and np.all(g[~mask] == 0.0)
+    np.testing.assert_allclose(mixed.distance(square, q), d)
+    other = mixed.distance(square, q[:4])  # another batch than the check points: the model's
+    assert np.all(other == 1.0)
+    if isinstance(model, DeferredLiar):
+        d2, grad = mixed.distance_deferred_grad(square, q)
+        np.testing.assert_allclose(d2, d)
+        g2 = grad()
+        np.testing.assert_allclose(g2[mask], g_coal[mask])
+        assert np.all(g2[~mask] == 7.0)
+    else:
+        assert not hasattr(mixed, "distance_deferred_grad")
+    assert with_exact_rows(model, np.array([2, 2]), np.zeros(2, bool)) is model
+
+
+def test_a_model_that_lies_everywhere_is_certified_once_coal_rows_cover_the_path(square):
+    """The liar rates every path free, so Ipopt keeps the seed's straightened path through the
+    square and coal rejects it; with exact rows on the whole path (raise_window None) the next
+    round is coal's own NLP, and its path is certified. Raising the liar's bound (the old rule)
+    cannot fix a zero gradient: that plan fails."""
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
+    seeds = SeedConfig(initial="rrt", starts=1, count=1)
+    exact = plan(p, collision=Liar(), solver=PlanConfig(seeds, RefineConfig(raise_window=None)))
+    assert exact.success, exact.reason
+    assert certify_path(square, exact.q, p.certified_clearance).ok
+    raised = RefineConfig(raise_window=None, exact_rows=False)
+    assert not plan(p, collision=Liar(), solver=PlanConfig(seeds, raised)).success
