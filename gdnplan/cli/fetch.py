@@ -15,7 +15,7 @@ if TYPE_CHECKING:  # the commands import numpy and the library when they run: a 
 
 from .app import app
 from .common import QUIET_HELP, THREADS_HELP, WEIGHTS_HELP, set_threads, show_progress
-from .plan import clearance_text
+from .plan import echo_stages
 
 
 @app.command("fetch")
@@ -75,14 +75,7 @@ def fetch_command(
         summary["stages"] = [s.summary() for s in stages]
         typer.echo(json.dumps(summary))
     else:
-        for s in stages:
-            how = "planned" if s.planned else "scripted"
-            verdict = "certified" if s.success else f"FAILED ({s.detail})"
-            typer.echo(
-                f"{s.name:<10} {s.scene.robot.info['gripper']:<8} {how:<8} {verdict}; "
-                f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
-            )
-        total = sum(s.solve_time for s in stages)
+        total = echo_stages(stages, [s.scene.robot.info["gripper"] for s in stages])
         verdict = "success" if ok else "FAILED"
         typer.echo(f"fetch seed {seed} ({collision}): {verdict}, {total:.1f} s in all")
     if animate is not None:

@@ -9,7 +9,7 @@ import typer
 
 from ..errors import InputError
 from .common import parse_vector
-from .plan import clearance_text
+from .plan import echo_stages
 
 
 def parse_placement(text: str | None):
@@ -59,14 +59,7 @@ def run_fetch3d_command(
         }
         typer.echo(json.dumps(summary))
     else:
-        for s in stages:
-            how = "planned" if s.planned else "scripted"
-            verdict = "certified" if s.success else f"FAILED ({s.detail})"
-            typer.echo(
-                f"{s.name:<10} {s.gripper:<8} {how:<8} {verdict}; "
-                f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
-            )
-        total = sum(s.solve_time for s in stages)
+        total = echo_stages(stages, [s.gripper for s in stages])
         verdict = "success" if ok else "FAILED"
         where_text = f"storage at x {p.x:.3f} m, y {p.y:.3f} m, yaw {p.yaw:.3f} rad"
         typer.echo(f"fetch 3-D seed {seed} ({where_text}): {verdict}, {total:.1f} s in all")

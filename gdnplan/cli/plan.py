@@ -176,6 +176,19 @@ def plan_flags_config(problem, solver: str | None, seeds: int | None, time_budge
     return config
 
 
+def echo_stages(stages, grippers) -> float:
+    """Print one line per fetch stage (name, gripper, planned/scripted, verdict, clearance,
+    time) and return the stages' total solve time (s); ``grippers``: each stage's gripper."""
+    for s, gripper in zip(stages, grippers, strict=True):
+        how = "planned" if s.planned else "scripted"
+        verdict = "certified" if s.success else f"FAILED ({s.detail})"
+        typer.echo(
+            f"{s.name:<10} {gripper:<8} {how:<8} {verdict}; "
+            f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
+        )
+    return sum(s.solve_time for s in stages)
+
+
 def clearance_text(lower_bound: float) -> str:
     """'certified clearance ≥ +0.0123 m', or 'clearance not proven' for a −inf bound."""
     if not math.isfinite(lower_bound):
