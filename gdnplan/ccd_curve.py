@@ -1,7 +1,13 @@
 """Continuous collision certificate of a cubic joint-space curve (the timed ``smooth`` path).
 
 Bound (1) of :mod:`gdnplan.ccd` needs only that no robot point moves farther than
-δ = max_l Σ_j r_{l,j} ∫|q̇_j| ds along a piece (m). A straight piece has ∫|q̇_j| = |Δq_j|; a cubic
+δ = max_l Σ_j r_{l,j} ∫|q̇_j| ds along a piece (m); the lever arms r bound |p − o_j| at every
+configuration, so the bound holds along any joint curve, not only a straight one. The 3-D bound
+of :mod:`gdnplan.arm3d.ccd3d` (obstacle pairs and self pairs, Δ) is linear in the same per-joint
+travels, so one certificate serves both scene kinds: δ is the scene kind's motion bound
+(:func:`gdnplan.exact.motion_bound_of`) with |Δq_j| replaced by ∫|q̇_j| ds, and d the kind's
+exact distance (:func:`gdnplan.exact.exact_distance`, in 3-D self-collision included). A
+straight piece has ∫|q̇_j| = |Δq_j|; a cubic
 piece p_j(s), s ∈ [s_a, s_b], has the total variation TV_j = Σ_i |p_j(x_{i+1}) − p_j(x_i)| over
 x = s_a, the roots of the quadratic p'_j inside the piece, s_b (exact: p_j is monotone between
 them). With d̲ the proven coal distance at the piece's ends (:func:`gdnplan.ccd.proven_distance`),
@@ -21,11 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ccd import MIN_PIECE, lever_arms, proven_distance
-from .distance import signed_distance
+from .ccd import MIN_PIECE, proven_distance
 from .errors import InputError
+from .exact import exact_distance, motion_bound_of
 from .limits import check_int, check_number
-from .scene import Scene
 
 CURVE_SPLITS = 4  # pieces each knot interval starts with
 CURVE_MAX_CHECKS = 200_000  # coal evaluations allowed
@@ -64,7 +69,7 @@ class CurveCertificate:
 
 
 def certify_curve(
-    scene: Scene,
+    scene,
     curve,
     margin: float = 0.0,
     tol: float = 1e-3,
@@ -75,7 +80,7 @@ def certify_curve(
     coal distance above ``margin`` (m), by the bound of the module docstring.
 
     Args:
-        scene: robot and obstacles.
+        scene: robot and obstacles, a planar ``Scene`` or a ``Scene3D``.
         curve: a cubic ``scipy.interpolate.PPoly`` (e.g. a PchipInterpolator) of shape (dof,).
         margin: clearance to prove (m), finite and ≥ 0.
         tol: bisect until the proven bound is within ``tol`` of the smallest checked distance
@@ -89,18 +94,19 @@ def certify_curve(
     check_int(max_checks, "max_checks", 1, 10**9)
     if curve.c.ndim != 3 or curve.c.shape[0] != 4 or curve.c.shape[2] != scene.robot.dof:
         raise InputError(f"curve: expected a cubic PPoly of {scene.robot.dof} joints")
-    robot, arms = scene.robot, lever_arms(scene.robot)
+    robot = scene.robot
+    zero = np.zeros(robot.dof)
     x = curve.x
     s = np.linspace(0.0, 1.0, splits + 1)
     nodes = np.unique((x[:-1, None] + s[None] * np.diff(x)[:, None]).ravel())
     nodes = np.unique(np.concatenate([nodes, x]))
-    d = proven_distance(signed_distance(scene, robot.check_q(curve(nodes), "curve")))
+    d = proven_distance(exact_distance(scene, robot.check_q(curve(nodes), "curve")))
     sa, sb, da, db = nodes[:-1], nodes[1:], d[:-1], d[1:]
     n_checks, lower, best = len(nodes), math.inf, float(np.min(d))
     while len(sa):
         if np.any(da <= margin) or np.any(db <= margin):
             return CurveCertificate(False, -math.inf, n_checks)
-        delta = np.max(_total_variation(curve, sa, sb) @ arms.T, axis=1)
+        delta = motion_bound_of(robot, zero[None], _total_variation(curve, sa, sb))
         bound = (da + db - delta) / 2
         proven = (bound > margin) & (bound >= best - tol)
         if proven.any():
@@ -110,7 +116,7 @@ def certify_curve(
             return CurveCertificate(False, -math.inf, n_checks)
         sa, sb, da, db = sa[keep], sb[keep], da[keep], db[keep]
         mid = (sa + sb) / 2
-        dm = proven_distance(signed_distance(scene, curve(mid))) if len(mid) else mid
+        dm = proven_distance(exact_distance(scene, curve(mid))) if len(mid) else mid
         n_checks += len(mid)
         best = min(best, float(np.min(dm))) if len(dm) else best
         sa, sb = np.concatenate([sa, mid]), np.concatenate([mid, sb])

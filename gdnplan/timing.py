@@ -1,8 +1,9 @@
 """Time parametrisation of a certified joint path under velocity and acceleration limits.
 
 The planner certifies the piecewise-linear path through its waypoints q_0 … q_{T−1} (rad)
-(:func:`gdnplan.ccd.certify_path`). :func:`time_path` gives it times 0 = t_0 ≤ … ≤ t_{T−1} (s)
-in one of three ways, each of them along a path that is certified collision-free:
+(:func:`gdnplan.ccd.certify_path`; 3-D: :func:`gdnplan.arm3d.certify_path3d`).
+:func:`time_path` gives it times 0 = t_0 ≤ … ≤ t_{T−1} (s) in one of three ways, each of them
+along a path that is certified collision-free:
 
 ``linear`` (velocity limits v only, the default): the exact waypoint polygon at constant speed,
     segment k taking τ_k = max_j |Δq_{k,j}| / v_j. The fastest motion along the polygon under
@@ -22,8 +23,10 @@ in one of three ways, each of them along a path that is certified collision-free
     with corners cannot be followed exactly at bounded acceleration without stopping at them.
 
 The curve certificate (:mod:`gdnplan.ccd_curve`) is the planner's (bound (1) of
-:mod:`gdnplan.ccd`) with each joint's straight travel |Δq_j| replaced by the cubic's exact total
-variation over the piece.
+:mod:`gdnplan.ccd`, or of :mod:`gdnplan.arm3d.ccd3d` for a 3-D scene, self-collision included)
+with each joint's straight travel |Δq_j| replaced by the cubic's exact total variation over the
+piece. Velocity limits default to the URDF's (Pinocchio's ``model.velocityLimit``), planar and
+3-D robots alike.
 """
 
 from __future__ import annotations
@@ -33,6 +36,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .arm3d.robot3d import Robot3D
+from .arm3d.scene3d import Scene3D
 from .ccd_curve import certify_curve
 from .errors import InputError
 from .limits import MAX_TIMED_SAMPLES, check_number, is_number
@@ -59,7 +64,7 @@ def limit_vector(value, dof: int, name: str, unit: str) -> np.ndarray:
     return out
 
 
-def urdf_velocity(robot: Robot) -> np.ndarray:
+def urdf_velocity(robot: Robot | Robot3D) -> np.ndarray:
     """(dof,) velocity limits of the robot's URDF (rad/s); InputError naming the first joint
     whose limit is missing (URDF velocity="0"; a continuous joint without <limit> gives inf)."""
     v = np.asarray(robot.model.velocityLimit, float)
@@ -335,7 +340,7 @@ def time_path(
     q: np.ndarray,
     max_velocity,
     max_acceleration=None,
-    scene: Scene | None = None,
+    scene: Scene | Scene3D | None = None,
 ) -> TimedTrajectory:
     """Time-parametrise the certified waypoint path q (T, dof) rad; see the module docstring.
 
@@ -343,8 +348,9 @@ def time_path(
         q: (T, dof) finite waypoints (rad), T ≥ 1.
         max_velocity: velocity limit (rad/s), one number or dof numbers, each > 0.
         max_acceleration: acceleration limit (rad/s²) likewise; None: ``linear``.
-        scene: with max_acceleration, try the ``smooth`` curve and certify it here; None (or a
-            curve whose certificate fails, or toppra finding no solution): ``stop``.
+        scene: with max_acceleration, try the ``smooth`` curve and certify it here (a planar
+            ``Scene`` or a ``Scene3D``); None (or a curve whose certificate fails, or toppra
+            finding no solution): ``stop``.
     """
     q = np.asarray(q, float)
     if q.ndim != 2 or len(q) < 1 or not np.all(np.isfinite(q)):
@@ -371,15 +377,19 @@ def time_path(
 
 
 def plan_timing(
-    scene: Scene, q: np.ndarray, success: bool, max_velocity=None, max_acceleration=None
+    scene: Scene | Scene3D,
+    q: np.ndarray,
+    success: bool,
+    max_velocity=None,
+    max_acceleration=None,
 ) -> tuple[TimedTrajectory | None, str]:
     """The timing of a plan's path q (T, dof) and a note on why there is none ("" if there is).
 
     None for a failed plan, and for a robot whose URDF lacks velocity limits when no
     ``max_velocity`` is given (the note says which joint). ``max_acceleration`` selects the
-    ``smooth`` curve certified in ``scene`` (or ``stop``), see :func:`time_path`; the curve
-    certificate is planar, so a 3-D scene gets ``stop`` (the certified polygon, at rest at
-    every waypoint).
+    ``smooth`` curve certified in ``scene`` (or ``stop``), see :func:`time_path`, for planar
+    and 3-D scenes alike (:mod:`gdnplan.ccd_curve` certifies the curve with the scene kind's
+    exact distance and motion bound; in 3-D self-collision included).
     """
     if not success:
         return None, ""
@@ -387,7 +397,7 @@ def plan_timing(
         v = urdf_velocity(scene.robot) if max_velocity is None else max_velocity
     except InputError as e:
         return None, f"no timing: {e}"
-    curve_scene = scene if isinstance(scene, Scene) and max_acceleration is not None else None
+    curve_scene = scene if max_acceleration is not None else None
     return time_path(q, v, max_acceleration, curve_scene), ""
 
 
