@@ -81,11 +81,19 @@ def plan_command(
         help="Wall-time budget (s): return the cheapest certified path found when it ends.",
     ),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
-    animate: Path = typer.Option(None, help="Write an animated GIF of the plan."),
+    animate: Path = typer.Option(
+        None,
+        help="Write an animated GIF of the plan (3-D problems: the arm, the obstacles and "
+        "the clearance along the timed path).",
+    ),
     threads: int = typer.Option(1, help=THREADS_HELP),
-    view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
+    view3d: bool = typer.Option(
+        False, "--view3d", help="3-D browser view (needs meshcat); planar and 3-D problems."
+    ),
     max_acceleration: float = typer.Option(
-        None, help="Joint acceleration limit (rad/s²) of the timing; default: velocity only."
+        None,
+        help="Joint acceleration limit (rad/s²) of the timing: a smooth curve with its own "
+        "certificate (planar and 3-D); default: velocity limits only.",
     ),
     quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
 ) -> None:
@@ -106,9 +114,6 @@ def plan_command(
     problem = Problem.from_toml(problem_file)
     if collision is None:
         collision = "coal" if is_3d(problem.scene) else "graphdistnet"
-    if is_3d(problem.scene) and (animate is not None or view3d):
-        flag = "--animate" if animate is not None else "--view3d"
-        raise InputError(f"{flag}: planar problems only (the 3-D arms' viewer is not written yet)")
     config = plan_flags_config(problem, solver, seeds, time_budget)
     result = plan(
         problem,
@@ -122,24 +127,30 @@ def plan_command(
         typer.echo(json.dumps(plan_summary(result, problem.scene.robot.joint_names)))
     else:
         verdict = "certified collision-free" if result.success else f"FAILED ({result.reason})"
-        timed = "" if result.duration is None else f", duration {result.duration:.2f} s"
+        timed = "" if result.trajectory is None else f", {timing_text(result.trajectory)}"
         typer.echo(
             f"{problem_file}: {verdict}; {clearance_text(result.min_distance)}, "
             f"solve time {result.solve_time:.2f} s, {result.iterations} iterations, "
             f"path cost {result.path_cost:.3f}{timed}"
         )
+    title = f"{Path(problem_file).name}: {collision}"
+    # a 3-D plan is shown along its timed path (the polygon, or the certified smooth curve)
+    shown = result.q if result.trajectory is None else result.trajectory
     if animate is not None:
-        from ..viz import animate_paths
+        if is_3d(problem.scene):
+            from ..viz3d.animate import animate_paths3d
 
-        animate_paths(
-            [(problem.scene, result.q)], animate, title=f"{Path(problem_file).name}: {collision}"
-        )
+            animate_paths3d([(problem.scene, shown)], animate, title=title, margin=result.clearance)
+        else:
+            from ..viz import animate_paths
+
+            animate_paths([(problem.scene, result.q)], animate, title=title)
         if not json_output:
             typer.echo(f"wrote {animate}")
     if view3d:
         from ..viz3d import view_plan
 
-        view_plan([(problem.scene, result.q)])
+        view_plan([(problem.scene, shown if is_3d(problem.scene) else result.q)])
     if not result.success:
         raise typer.Exit(1)
 
@@ -187,6 +198,14 @@ def echo_stages(stages, grippers) -> float:
             f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
         )
     return sum(s.solve_time for s in stages)
+
+
+def timing_text(traj) -> str:
+    """'duration 2.24 s (smooth curve, certified clearance ≥ +0.0206 m)', or the duration with
+    the timing's kind ('linear' / 'stop': the certified waypoint polygon)."""
+    if traj.kind == "smooth":
+        return f"duration {traj.duration:.2f} s (smooth curve, {clearance_text(traj.min_distance)})"
+    return f"duration {traj.duration:.2f} s ({traj.kind}, along the certified polygon)"
 
 
 def clearance_text(lower_bound: float) -> str:

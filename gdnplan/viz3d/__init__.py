@@ -13,17 +13,26 @@ A fetch stick is the box it is: ``stick_width`` deep (its square section), lying
 while it is an obstacle, and carried by the gripper (its near end ``GRASP_GAP`` in front of the
 palm, as :mod:`gdnplan.ur5e` attaches it) while the robot holds it.
 
-Needs ``pip install meshcat`` (the ``viz3d`` extra); :func:`scene_objects`,
+3-D plans (:class:`~gdnplan.arm3d.Scene3D`) need no extrusion: :mod:`~gdnplan.viz3d.meshes`
+turns the coal shapes of the arm and the obstacles into triangle meshes, which
+:mod:`~gdnplan.viz3d.animate` renders into a GIF with matplotlib (headless, no meshcat) and
+:mod:`~gdnplan.viz3d.viewer3d` sends to meshcat.
+
+Needs ``pip install meshcat`` (the ``viz3d`` extra) for the browser view; :func:`scene_objects`,
 :func:`full_robot` and :func:`frame_poses` are pure and work without it.
 
 Modules: :mod:`~gdnplan.viz3d.objects` (obstacles as prisms), :mod:`~gdnplan.viz3d.model`
 (the full robot and the held stick), :mod:`~gdnplan.viz3d.frames` (animation frames) and
-:mod:`~gdnplan.viz3d.viewer` (meshcat); every public name is re-exported here.
+:mod:`~gdnplan.viz3d.viewer` (meshcat); for 3-D plans :mod:`~gdnplan.viz3d.meshes`,
+:mod:`~gdnplan.viz3d.animate` (the GIF) and :mod:`~gdnplan.viz3d.viewer3d` (meshcat); every
+public name is re-exported here.
 """
 
 from __future__ import annotations
 
+from .animate import animate_paths3d
 from .frames import Frame, frame_poses
+from .meshes import obstacle_triangles, robot_triangles, shape_mesh, tool_positions
 from .model import FullRobot, full_robot, held_stick
 from .objects import COLORS, DEPTH, OBSTACLE_COLOR, Prism, scene_objects, tool_offset
 from .viewer import (
@@ -34,6 +43,7 @@ from .viewer import (
     send_plan,
     view_plan,
 )
+from .viewer3d import Mesh3D, camera3d, frames3d, scene3d_meshes, send_plan3d
 
 __all__ = [
     "COLORS",
@@ -43,14 +53,24 @@ __all__ = [
     "ROBOT_COLOR",
     "Frame",
     "FullRobot",
+    "Mesh3D",
     "Prism",
+    "animate_paths3d",
+    "camera3d",
     "camera_placement",
     "frame_poses",
+    "frames3d",
     "full_robot",
     "held_stick",
+    "obstacle_triangles",
     "require_meshcat",
+    "robot_triangles",
+    "scene3d_meshes",
     "scene_objects",
     "send_plan",
+    "send_plan3d",
+    "shape_mesh",
     "tool_offset",
+    "tool_positions",
     "view_plan",
 ]

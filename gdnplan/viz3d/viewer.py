@@ -11,11 +11,13 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
+from ..arm3d.scene3d import Scene3D
 from ..errors import GdnplanError
 from ..robot import Robot
 from ..scene import Scene
 from .frames import Frame, frame_poses
 from .model import full_robot
+from .viewer3d import send_plan3d
 
 ROBOT_COLOR = (0.62, 0.68, 0.75, 1.0)  # rgba
 INSTALL_HINT = "pip install 'gdnplan[viz3d]' (or: pip install meshcat)"
@@ -83,7 +85,9 @@ def view_plan(
     stderr (stdout stays clean for ``--json``).
 
     Args:
-        segments: (scene, path (T, dof)) pairs, as :func:`frame_poses`.
+        segments: (scene, path (T, dof)) pairs, as :func:`frame_poses`; for 3-D scenes
+            (:class:`~gdnplan.arm3d.Scene3D`) the path may be a TimedTrajectory, and the
+            plan goes to :func:`gdnplan.viz3d.viewer3d.send_plan3d`.
         zmq_url: e.g. ``"tcp://127.0.0.1:6000"``, or None to start a server.
         per_segment: frames per path segment.
         fps: animation frames per second.
@@ -92,7 +96,8 @@ def view_plan(
     meshcat = require_meshcat()
     with contextlib.redirect_stdout(sys.stderr):
         viewer = meshcat.Visualizer(zmq_url)
-    n = send_plan(viewer, segments, per_segment, fps)
+    send = send_plan3d if segments and isinstance(segments[0][0], Scene3D) else send_plan
+    n = send(viewer, segments, per_segment, fps)
     url = viewer.url()
     print(f"3-D view: {url} ({n} frames; the Animations panel replays them)", file=sys.stderr)
     if zmq_url is None and wait:
