@@ -18,6 +18,7 @@ direction of motion (the trace's principal axis), from the side the arm reaches 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -89,7 +90,7 @@ def _view_azimuth(tool: np.ndarray) -> float:
 
 def animate_paths3d(
     stages: Sequence[tuple[Scene3D, np.ndarray | TimedTrajectory]],
-    out,
+    out: str | Path,
     frames: int = 60,
     fps: int = 12,
     title: str = "",
