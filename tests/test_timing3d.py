@@ -82,3 +82,24 @@ def test_curve_through_the_post_is_not_certified(post):
     assert not certify_curve(post, curve).ok
     traj = time_path(q, 1.0, 4.0, post)
     assert traj.kind == "stop" and traj.min_distance is None  # the polygon, at rest at waypoints
+
+
+def test_cli_json_of_a_smooth_3d_timing(tmp_path, capsys):
+    import json
+
+    from gdnplan.cli import run
+
+    problem = tmp_path / "free.toml"
+    problem.write_text(
+        '[robot]\nname = "ur5e"\n[scene3d]\n[[scene3d.obstacles]]\ntype = "box"\n'
+        "size = [0.1, 0.1, 0.1]\nposition = [0.0, 0.8, 0.3]\n"
+        f"[start]\nq = {START}\n[goal]\nq = {GOAL}\n"
+    )
+    with pytest.raises(SystemExit) as exit_:
+        run(["plan", str(problem), "--json", "-q", "--max-acceleration", "3"])
+    assert exit_.value.code == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["timing"] == "smooth" and out["timing_min_distance"] > 0
+    t, q = np.array(out["t"]), np.array(out["q"])
+    assert t[0] == 0 and t[-1] == out["duration"] and np.all(np.diff(t) > 0)
+    np.testing.assert_allclose(q[[0, -1]], [START, GOAL], atol=1e-9)

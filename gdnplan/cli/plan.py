@@ -226,6 +226,8 @@ def plan_summary(result, joint_names: list[str]) -> dict:
 
     ``t`` (s) is the time of each row of ``q`` (rad, columns in ``joint_names`` order), and
     ``timing`` its kind (:mod:`gdnplan.timing`); both null when the plan has no trajectory.
+    ``timing_min_distance`` (m): the proven clearance of the ``smooth`` curve (planar or 3-D),
+    null for the other kinds (they follow the certified polygon).
     """
     traj = result.trajectory
     import numpy as np
@@ -237,6 +239,9 @@ def plan_summary(result, joint_names: list[str]) -> dict:
         "t": None if traj is None else traj.times.tolist(),
         "duration": None if traj is None else traj.duration,
         "timing": None if traj is None else traj.kind,
+        "timing_min_distance": None
+        if traj is None or traj.min_distance is None
+        else json_number(traj.min_distance),
         "min_distance": json_number(result.min_distance),
         "sampled_min_distance": json_number(result.sampled_min_distance),
         "clearance": float(result.clearance),

@@ -39,7 +39,7 @@ OBSTACLE_RGBA = np.array([0.30, 0.50, 0.75, 0.30])  # see-through blue
 LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 CLEARANCE_SAMPLES = 200  # exact distances per stage for the clearance panel
 ELEVATION = 28.0  # degrees
-ZOOM = 1.05  # mplot3d box zoom
+ZOOM = 1.0  # mplot3d box zoom
 PALETTE_COLORS = 128  # GIF palette size, shared by all frames
 
 
@@ -158,7 +158,7 @@ def animate_paths3d(
 
     fig = Figure(figsize=(10, 5), dpi=dpi)
     canvas = FigureCanvasAgg(fig)
-    ax = fig.add_axes((0.0, 0.07, 0.66, 0.82), projection="3d", computed_zorder=False)
+    ax = fig.add_axes((0.0, 0.09, 0.66, 0.8), projection="3d", computed_zorder=False)
     ax.set_xlim(low[0], high[0])
     ax.set_ylim(low[1], high[1])
     ax.set_zlim(low[2], high[2])
