@@ -161,6 +161,8 @@ def test_gif_refuses_bad_stages(post, tmp_path):
         animate_paths3d([(post, path), (post, traj)], tmp_path / "x.gif")
     with pytest.raises(InputError, match="frames"):
         animate_paths3d([(post, path)], tmp_path / "x.gif", frames=1)
+    with pytest.raises(InputError, match="fps"):
+        animate_paths3d([(post, path)], tmp_path / "x.gif", fps=0)
     with pytest.raises(InputError, match="no path"):
         animate_paths3d([], tmp_path / "x.gif")
     assert not (tmp_path / "x.gif").exists()

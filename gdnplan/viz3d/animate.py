@@ -29,6 +29,7 @@ from ..arm3d.held import HELD_LINK
 from ..arm3d.scene3d import Scene3D
 from ..errors import InputError
 from ..files import atomic_path
+from ..limits import check_int
 from ..timing import TimedTrajectory
 from .meshes import obstacle_triangles, robot_triangles, tool_positions
 
@@ -40,6 +41,7 @@ LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 CLEARANCE_SAMPLES = 200  # exact distances per stage for the clearance panel
 ELEVATION = 28.0  # degrees
 ZOOM = 1.0  # mplot3d box zoom
+MAX_FRAMES = 2000  # frames of one GIF at most (each is kept in memory until written)
 PALETTE_COLORS = 128  # GIF palette size, shared by all frames
 
 
@@ -104,11 +106,12 @@ def animate_paths3d(
             (T, dof) in rad or a :class:`~gdnplan.timing.TimedTrajectory`. All stages are
             timed or none (the clearance panel's x axis: time in s, or the waypoint index).
         out: the ``.gif`` path (written atomically).
-        frames: frames in all (≥ 2 per stage), shared by the stages by their length.
-        fps: frames per second (the last frame is held for a second).
+        frames: frames in all (≥ 2 per stage, ≤ ``MAX_FRAMES``), shared by the stages by
+            their length (duration, or waypoint segments).
+        fps: frames per second, 1 to 100 (the last frame is held for a second).
         title: the figure's title.
         margin: the clearance the plan had to keep (m), drawn as a red dashed line.
-        dpi: pixels per inch of the 10 × 5 inch figure.
+        dpi: pixels per inch of the 10 × 5 inch figure, 10 to 400.
 
     Returns:
         The number of frames written.
@@ -126,8 +129,9 @@ def animate_paths3d(
     for scene, _ in stages:
         if not isinstance(scene, Scene3D):
             raise InputError(f"animate: expected a Scene3D, got {type(scene).__name__}")
-    if not (isinstance(frames, int) and frames >= 2 * len(stages)):
-        raise InputError(f"frames: expected an integer ≥ {2 * len(stages)}, got {frames!r}")
+    check_int(frames, "frames", 2 * len(stages), MAX_FRAMES)
+    check_int(fps, "fps", 1, 100)
+    check_int(dpi, "dpi", 10, 400)
     lengths = np.array([p.duration if timed else len(np.asarray(p)) - 1 for _, p in stages], float)
     share = lengths / lengths.sum() if lengths.sum() > 0 else np.full(len(stages), 1 / len(stages))
     counts = np.maximum(2, np.round(share * frames).astype(int))
