@@ -63,6 +63,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ur5e.plot",
             "arm3d",
             "arm3d.distance3d",
+            "arm3d.narrow3d",  # the pair table and coal's narrow phase of one pair
+            "arm3d.gradient3d",  # the exact gradient of a pair's distance
             "arm3d.ccd3d",
             "arm3d.ik3d",
             "arm3d.held",
