@@ -70,6 +70,9 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.held",
             "arm3d.fetch3d_scene",
             "arm3d.scene_file3d",  # 3-D problem-file tables -> Scene3D (pose goals by IK)
+            "arm3d.shape_file3d",  # posed-shape tables (obstacles, the held object)
+            "arm3d.robot_file3d",  # the [robot] table of 3-D files, a held object
+            "arm3d.write_file3d",  # Scene3D -> 3-D problem-file text
             "exact",  # the exact-geometry protocol of planar and 3-D scenes
             "path_metrics",
             "ompl_planner",
