@@ -184,7 +184,47 @@ def is_rotation(m) -> bool:
     return a.shape == (3, 3) and np.allclose(a @ a.T, np.eye(3), atol=1e-6) and np.linalg.det(a) > 0
 
 
+def cli_answer(cfg: dict, folder: Path, json: bool) -> tuple[int, list[str], str, list]:
+    """(exit code, stderr lines, stdout, files after) of ``gdnplan plan`` on ``cfg``."""
+    import contextlib
+    import io
+
+    from gdnplan.cli import run
+
+    path = folder / "p.toml"
+    path.write_text(tomli_w.dumps(cfg))
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        with pytest.raises(SystemExit) as exit_:
+            run(["plan", str(path), *(["--json"] if json else [])])
+    lines = err.getvalue().strip().splitlines()
+    return exit_.value.code, lines, out.getvalue(), sorted(folder.iterdir())
+
+
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(held=held_tables(), json=st.booleans())
+def test_the_cli_answers_a_bad_held_table_in_one_line_exit_2_writing_nothing(
+    tmp_path_factory, held, json
+):
+    cfg = copy.deepcopy(BRING_OUT)
+    cfg["robot"]["held"] = held
+    try:
+        cfg = tomllib.loads(tomli_w.dumps(cfg))
+        Problem.from_config(cfg)
+    except ProblemFileError:
+        pass
+    except (TypeError, ValueError, GdnplanError):
+        return  # not writable as TOML, or a well-formed table (a start in collision, say)
+    else:
+        return  # a valid held object: planning it is another test's business
+    folder = tmp_path_factory.mktemp("held")
+    code, lines, out, after = cli_answer(cfg, folder, json)
+    assert code == 2 and len(lines) == 1 and lines[0].startswith("error: "), lines
+    assert "[robot" in lines[0]  # names [robot.held] (or [robot] for a bad frame)
+    assert out == "" and after == [folder / "p.toml"]
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(matrix=matrices.filter(lambda m: not is_rotation(m)), json=st.booleans())
 def test_the_cli_refuses_a_held_non_rotation_in_one_line_exit_2_writing_nothing(
     tmp_path_factory, matrix, json
