@@ -1,5 +1,6 @@
-"""3-D signed distance of gdnplan.arm3d against independent truth: finite differences, a QP
-over the shapes' vertices, the brute-force minimum (the broad phase changes nothing)."""
+"""3-D signed distance of gdnplan.arm3d (gdnplan.arm3d.distance3d) against independent truth:
+a QP over the shapes' vertices, the brute-force minimum (the broad phase changes nothing).
+The gradients' finite-difference tests are in test_arm3d_gradient3d.py."""
 
 from __future__ import annotations
 
@@ -31,63 +32,6 @@ def panda_scene():
 @pytest.fixture(scope="module")
 def ur5e_scene():
     return random_boxes(load_robot3d("ur5e"), 20, seed=1)
-
-
-def fd_checks(checker: Checker3D, qs: np.ndarray, per_link: bool = False, h: float = 1e-5):
-    """(gradient, central difference, distance) of every configuration whose minimising pair
-    is the same at q ± h e_j for every joint (away from switches) and needed no coal retry."""
-    out = []
-    dof = checker.robot.dof
-    for q in qs:
-        before = checker.fallbacks
-        res = checker.evaluate(q, per_link, gradient=True)
-        fd = np.zeros_like(res.gradient[0])
-        same = True
-        for j in range(dof):
-            e = np.zeros(dof)
-            e[j] = h
-            plus, minus = checker.evaluate(q + e, per_link), checker.evaluate(q - e, per_link)
-            same &= np.array_equal(plus.pair, res.pair) and np.array_equal(minus.pair, res.pair)
-            fd[..., j] = (plus.distance[0] - minus.distance[0]) / (2 * h)
-        if same and checker.fallbacks == before:
-            out.append((res.gradient[0], fd, res.distance[0]))
-    return out
-
-
-def test_panda_mesh_gradients_match_central_differences_apart_and_in_penetration(panda_scene):
-    checker = Checker3D(panda_scene, tolerance=1e-9)
-    qs = panda_scene.robot.random_configurations(60, np.random.default_rng(2))
-    checks = fd_checks(checker, qs)
-    assert len(checks) >= 40
-    depths = np.array([d for _, _, d in checks])
-    assert (depths < 0).sum() >= 3 and (depths > 0).sum() >= 20  # both regimes are tested
-    for g, fd, _ in checks:
-        assert np.linalg.norm(g - fd) <= 1e-5 * max(np.linalg.norm(fd), 1e-2)
-
-
-def test_panda_per_link_gradients_match_central_differences(panda_scene):
-    checker = Checker3D(panda_scene, tolerance=1e-9)
-    qs = panda_scene.robot.random_configurations(6, np.random.default_rng(3))
-    checks = fd_checks(checker, qs, per_link=True)
-    assert checks
-    for g, fd, _ in checks:
-        err = np.linalg.norm(g - fd, axis=-1)
-        assert np.all(err <= 1e-5 * np.maximum(np.linalg.norm(fd, axis=-1), 1e-2))
-
-
-def test_ur5e_primitive_gradients_match_central_differences(ur5e_scene):
-    """Cylinders are curved: GJK's witness direction converges only like the square root of
-    its distance tolerance (and EPA fails on them below ~1e-8), so the bounds here are 1e-4
-    relative at the median, 1e-3 for 90 % and 1e-2 for all (1e-5 for polytopes above)."""
-    checker = Checker3D(ur5e_scene, tolerance=1e-8)
-    qs = ur5e_scene.robot.random_configurations(60, np.random.default_rng(2))
-    checks = fd_checks(checker, qs)
-    assert len(checks) >= 30
-    depths = np.array([d for _, _, d in checks])
-    assert (depths < 0).sum() >= 3 and (depths > 0).sum() >= 10
-    errors = [np.linalg.norm(g - fd) / max(np.linalg.norm(fd), 1e-1) for g, fd, _ in checks]
-    assert np.median(errors) <= 1e-4 and np.quantile(errors, 0.9) <= 1e-3
-    assert max(errors) <= 1e-2
 
 
 def qp_distance(a: np.ndarray, b: np.ndarray) -> float:

@@ -8,7 +8,7 @@ import json
 import pytest
 
 from gdnplan.arm3d.fetch3d import PLANNED, STAGES
-from gdnplan.arm3d.fetch3d_files import read_stage_problems
+from gdnplan.trajopt import Problem
 
 BAD = [
     ["fetch", "--3d", "--seed", "abc"],
@@ -55,4 +55,4 @@ def test_the_canonical_3d_fetch_is_certified_and_writes_its_problems(tmp_path, c
     assert all(s["success"] for s in summary["stages"])
     assert sorted(p.name for p in out.iterdir()) == sorted(f"fetch3d_{s}.toml" for s in PLANNED)
     for path in out.iterdir():
-        assert read_stage_problems(path)
+        assert Problem.from_toml(path).scene.robot.name == "ur5e"

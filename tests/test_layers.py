@@ -63,11 +63,16 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ur5e.plot",
             "arm3d",
             "arm3d.distance3d",
+            "arm3d.narrow3d",  # the pair table and coal's narrow phase of one pair
+            "arm3d.gradient3d",  # the exact gradient of a pair's distance
             "arm3d.ccd3d",
             "arm3d.ik3d",
             "arm3d.held",
             "arm3d.fetch3d_scene",
             "arm3d.scene_file3d",  # 3-D problem-file tables -> Scene3D (pose goals by IK)
+            "arm3d.shape_file3d",  # posed-shape tables (obstacles, the held object)
+            "arm3d.robot_file3d",  # the [robot] table of 3-D files, a held object
+            "arm3d.write_file3d",  # Scene3D -> 3-D problem-file text
             "exact",  # the exact-geometry protocol of planar and 3-D scenes
             "path_metrics",
             "ompl_planner",

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from gdnplan.arm3d.robot_file3d import HELD_FRAME_KEY
 from gdnplan.arm3d.scene_file3d import (
     OBSTACLE3D_KEYS,
     POSE_KEYS,
@@ -31,6 +32,13 @@ def keys_of(text: str) -> set[str]:
 
 def test_robot_keys_are_documented():
     assert keys_of(section("[robot]")) == set(ROBOT3D_KEYS)
+
+
+def test_held_keys_are_documented():
+    """[robot.held]: a posed shape's keys (as an obstacle's) plus its frame."""
+    text = section("[robot.held]")
+    own = set().union(*OBSTACLE3D_KEYS.values())
+    assert keys_of(text) == (set(POSE_KEYS) - set(ROTATION_KEYS)) | own | {HELD_FRAME_KEY}
 
 
 def test_scene3d_keys_are_documented():

@@ -5,7 +5,9 @@ distance with self-collision and its gradient.
 * :mod:`gdnplan.arm3d.robot3d`: :class:`Robot3D` from any URDF; :mod:`gdnplan.arm3d.builtin`:
   the UR5e, Panda and UR5; :mod:`gdnplan.arm3d.pairs`: self-collision pairs (SRDF).
 * :mod:`gdnplan.arm3d.scene3d`: obstacles and :class:`Scene3D`.
-* :mod:`gdnplan.arm3d.distance3d`: signed distance, gradient, broad phase.
+* :mod:`gdnplan.arm3d.distance3d`: signed distance and its minimising pairs (broad phase);
+  :mod:`gdnplan.arm3d.narrow3d`: the pair table and coal's narrow phase;
+  :mod:`gdnplan.arm3d.gradient3d`: the exact gradient.
 * :mod:`gdnplan.arm3d.ccd3d`: the continuous certificate of joint paths.
 * :mod:`gdnplan.arm3d.held`: an object held by the tool frame (the fetch's stick).
 * :mod:`gdnplan.arm3d.ik3d`: end-effector pose IK (damped least squares, collision-free).

@@ -1,48 +1,28 @@
 """Exact 3-D signed distance of a robot among obstacles and itself, with its exact gradient.
 
-The pairs of a :class:`~gdnplan.arm3d.scene3d.Scene3D` are every (robot shape, obstacle) and
-every enabled self-collision pair (robot shape, robot shape) of
-:attr:`~gdnplan.arm3d.robot3d.Robot3D.self_pairs`. For pair k between shape 1 and shape 2 coal
-returns the signed distance d_k (the distance when apart, minus the penetration depth when
-overlapping), witness points p₁ (on shape 1), p₂ (on shape 2) and the unit normal n from shape 1
-to shape 2, with p₂ − p₁ = d_k n. Moving both shapes rigidly, the first-order change of d_k is
-the normal component of the witness points' relative velocity, so
+A :class:`Checker3D` scans the pairs of a scene (:mod:`gdnplan.arm3d.narrow3d`: the pair
+table, coal's narrow phase and its conventions) for the minimising pair and takes its gradient
+∂d/∂q = nᵀ(J(p₂) − J(p₁)) (:mod:`gdnplan.arm3d.gradient3d`). The overall distance is min_k d_k,
+a link's distance is the minimum over the pairs it takes part in (a self pair counts for both
+links); each takes the gradient of its minimising pair.
 
-    ∂d_k/∂q = nᵀ (J(p₂) − J(p₁))                                     (1, dof), m/rad
-
-with J(p) (3, dof) the Jacobian of the world point p fixed on its body
-(:meth:`~gdnplan.arm3d.robot3d.Robot3D.point_jacobian`, LOCAL_WORLD_ALIGNED; zero for an
-obstacle). For an obstacle pair shape 1 is the robot's: ∂d/∂q = −nᵀ J(p₁). The overall distance
-is min_k d_k, a link's distance is the minimum over the pairs it takes part in (a self pair
-counts for both links); each takes the gradient (1) of its minimising pair. The gradient is
-exact wherever that pair and its witness points are unique (away from ties and switches).
-
-Broad phase: every shape has a bounding sphere (centre c, radius r, from coal's local AABB), so
-d_k ≥ b_k = |c₁ − c₂| − r₁ − r₂. Pairs are sent to GJK/EPA in increasing order of b_k and only
-while b_k is below the current best of a result they could still lower; a pair with b_k ≥ ``cap``
-never is. A result no pair below ``cap`` reaches reports ``cap`` with a zero gradient and pair −1.
-Without the broad phase every pair is sent (the same minima when they are below ``cap``).
-
-coal's EPA sometimes fails on curved shapes at tight tolerances (it returns −DBL_MAX): such a
-pair is recomputed with coal's default request, and if that fails too it reports its
-bounding-sphere bound b_k (a lower bound, with a warning on the ``gdnplan.arm3d`` logger).
+Broad phase: every pair has the lower bound b_k = |c₁ − c₂| − r₁ − r₂ ≤ d_k of its bounding
+spheres. Pairs are sent to GJK/EPA in increasing order of b_k and only while b_k is below the
+current best of a result they could still lower; a pair with b_k ≥ ``cap`` never is. A result
+no pair below ``cap`` reaches reports ``cap`` with a zero gradient and pair −1. Without the
+broad phase every pair is sent (the same minima when they are below ``cap``).
 """
 
 from __future__ import annotations
 
-import logging
 import weakref
 from dataclasses import dataclass
 
-import coal
 import numpy as np
 
-from ..errors import InputError
-from .fk3d import shape_placements_batch
-from .robot3d import point_jacobians
+from .gradient3d import pair_gradients
+from .narrow3d import PairTable, check_cap
 from .scene3d import Scene3D
-
-log = logging.getLogger("gdnplan.arm3d")
 
 
 @dataclass
@@ -69,116 +49,14 @@ class Distances3D:
     narrow: np.ndarray
 
 
-class Checker3D:
-    """coal shapes, pair table and distance functors of one 3-D scene, reused across calls.
+class Checker3D(PairTable):
+    """The minimum signed distance (overall or per link) of a scene's pairs, with gradients.
 
     Args:
         scene: the robot and its obstacles.
         tolerance: GJK and EPA tolerance of coal's request (coal's default 1e-6 when None);
             distances are within about ``tolerance · (1 + |d|)`` m of the exact ones.
     """
-
-    def __init__(self, scene: Scene3D, tolerance: float | None = None):
-        robot = scene.robot
-        self.scene, self.robot = scene, robot
-        n_shapes, n_obs = len(robot.shapes), len(scene.obstacles)
-        obs = np.stack(np.meshgrid(np.arange(n_shapes), np.arange(n_obs), indexing="ij"), -1)
-        obs = obs.reshape(-1, 2)
-        self.pair_a = np.concatenate([obs[:, 0], robot.self_pairs[:, 0]]).astype(int)
-        self.pair_b = np.concatenate([obs[:, 1], robot.self_pairs[:, 1]]).astype(int)
-        self.is_self = np.r_[np.zeros(len(obs), bool), np.ones(len(robot.self_pairs), bool)]
-        self.link_a = robot.shape_link[self.pair_a]
-        self.n_obstacle_pairs = len(obs)  # pairs [0, n_obstacle_pairs) are obstacle pairs
-        self_b = robot.self_pairs[:, 1]
-        self.link_b = np.r_[np.full(len(obs), -1), robot.shape_link[self_b]].astype(int)
-        self.shape_center = np.array([s.center for s in robot.shapes]).reshape(-1, 3)
-        self.shape_radius = np.array([s.radius for s in robot.shapes])
-        self.obs_center = np.array([o.center for o in scene.obstacles]).reshape(-1, 3)
-        obs_radius = np.array([o.radius for o in scene.obstacles])
-        self.radius_sum = (
-            self.shape_radius[self.pair_a] + np.r_[obs_radius[obs[:, 1]], self.shape_radius[self_b]]
-        )
-        self.functors = [
-            coal.ComputeDistance(
-                robot.shapes[a].shape,
-                robot.shapes[b].shape if s else scene.obstacles[b].shape,
-            )
-            for a, b, s in zip(self.pair_a, self.pair_b, self.is_self, strict=True)
-        ]
-        self.request = coal.DistanceRequest()
-        self.request.enable_signed_distance = True
-        if tolerance is not None:
-            self.request.gjk_tolerance = tolerance
-            self.request.epa_tolerance = tolerance
-        self.fallback = coal.DistanceRequest()  # coal's defaults: retried when EPA fails
-        self.fallback.enable_signed_distance = True
-        self.fallbacks = 0  # pairs retried with the fallback request
-        self.result = coal.DistanceResult()
-
-    @property
-    def n_pairs(self) -> int:
-        return len(self.functors)
-
-    def pair_names(self) -> list[tuple[str, str]]:
-        """(shape 1, shape 2) names of every pair: ``link/geometry`` or the obstacle's name."""
-        shapes, obstacles = self.robot.shapes, self.scene.obstacles
-        out = []
-        for a, b, s in zip(self.pair_a, self.pair_b, self.is_self, strict=True):
-            other = f"{shapes[b].link}/{shapes[b].name}" if s else obstacles[b].name
-            out.append((f"{shapes[a].link}/{shapes[a].name}", other))
-        return out
-
-    # ------------------------------------------------------------------ one configuration
-    def placements(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """World placements (S, 4, 4) of the robot shapes and pair lower bounds b (P,) (m)."""
-        tf, bounds = self.placements_batch(np.asarray(q, float)[None])
-        return tf[0], bounds[0]
-
-    def placements_batch(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(B, S, 4, 4) shape placements and (B, P) pair lower bounds b (m) of q (B, dof), in
-        numpy for the whole batch (:mod:`gdnplan.arm3d.fk3d`)."""
-        tf = shape_placements_batch(self.robot, q)
-        centers = np.einsum("bsij,sj->bsi", tf[..., :3, :3], self.shape_center) + tf[..., :3, 3]
-        m = self.n_obstacle_pairs
-        obstacles = np.broadcast_to(self.obs_center[self.pair_b[:m]], (len(q), m, 3))
-        other = np.concatenate([obstacles, centers[:, self.pair_b[m:]]], axis=1)
-        gap = np.linalg.norm(centers[:, self.pair_a] - other, axis=2)
-        return tf, gap - self.radius_sum
-
-    def pair(self, k: int, tf: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
-        """Signed distance (m), witness points p₁, p₂ (3,) and normal n (3,) of pair k."""
-        a, b = self.pair_a[k], self.pair_b[k]
-        tf_a = coal.Transform3s(tf[a, :3, :3], tf[a, :3, 3])
-        if self.is_self[k]:
-            tf_b = coal.Transform3s(tf[b, :3, :3], tf[b, :3, 3])
-        else:
-            tf_b = self.scene.obstacles[b].pose
-        res = self.result
-        res.clear()
-        self.functors[k](tf_a, tf_b, self.request, res)
-        d = float(res.min_distance)
-        if not np.isfinite(d) or d < -self.radius_sum[k]:  # EPA failed (returns −DBL_MAX)
-            res.clear()
-            self.functors[k](tf_a, tf_b, self.fallback, res)
-            d = float(res.min_distance)
-            self.fallbacks += 1
-            if not np.isfinite(d) or d < -self.radius_sum[k]:
-                return self._sphere_bound(k, tf_a, tf_b)
-        p1 = np.array(res.getNearestPoint1())
-        p2 = np.array(res.getNearestPoint2())
-        return d, p1, p2, np.array(res.normal)
-
-    def _sphere_bound(self, k: int, tf_a, tf_b) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
-        """The bounding-sphere lower bound of pair k with its witnesses (coal failed twice)."""
-        log.warning("coal failed on pair %s; using its bounding-sphere bound", self.pair_names()[k])
-        a, b = self.pair_a[k], self.pair_b[k]
-        ca = tf_a.transform(self.shape_center[a])
-        cb = tf_b.transform(self.shape_center[b]) if self.is_self[k] else self.obs_center[b]
-        gap = cb - ca
-        n = gap / max(np.linalg.norm(gap), 1e-12)
-        d = float(np.linalg.norm(gap) - self.radius_sum[k])
-        r_a = self.shape_radius[a]
-        return d, ca + r_a * n, ca + (r_a + d) * n, n
 
     def scan(self, q: np.ndarray, per_link: bool, cap: float, broad_phase: bool, placed=None):
         """Minimising pairs of one configuration: (targets T; T = 1 or L) arrays of distance,
@@ -226,23 +104,9 @@ class Checker3D:
 
     def gradient(self, q: np.ndarray, pair: np.ndarray, p1, p2, normal) -> np.ndarray:
         """(T, dof) gradients nᵀ(J(p₂) − J(p₁)) of the minimising pairs (0 where pair = −1)."""
-        out = np.zeros((len(pair), self.robot.dof))
-        live = pair >= 0
-        if not live.any():
-            return out
-        jac, origins = self.robot.joint_jacobians(q)
-        k = pair[live]
-        body_a = self.robot.shape_body[self.pair_a[k]]
-        ja = point_jacobians(jac[body_a], origins[body_a], p1[live])
-        grad = -np.einsum("ti,tij->tj", normal[live], ja)
-        self_rows = self.is_self[k]
-        if self_rows.any():
-            body_b = self.robot.shape_body[self.pair_b[k[self_rows]]]
-            jb = point_jacobians(jac[body_b], origins[body_b], p2[live][self_rows])
-            grad[self_rows] += np.einsum("ti,tij->tj", normal[live][self_rows], jb)
-        out[live] = grad
-        return out
+        return pair_gradients(self, q, pair, p1, p2, normal)
 
+    # ------------------------------------------------------------------ batches
     # ------------------------------------------------------------------ batches
     def evaluate(
         self,
@@ -254,7 +118,7 @@ class Checker3D:
     ) -> Distances3D:
         """Signed distances (and gradients) of configurations q (B, dof) or (dof,) in rad."""
         q = self.robot.check_q(q)
-        cap = _check_cap(cap)
+        cap = check_cap(cap)
         tf, bounds = self.placements_batch(q)
         rows = [
             self.scan(qi, per_link, cap, broad_phase, (tf[i], bounds[i])) for i, qi in enumerate(q)
@@ -276,30 +140,6 @@ class Checker3D:
             squeeze(nrm),
             narrow,
         )
-
-    def pair_distances(self, q: np.ndarray, cap: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
-        """(B, P) signed distance of every pair (``cap`` where the lower bound reaches it) and
-        (B,) narrow-phase counts."""
-        q = self.robot.check_q(q)
-        cap = _check_cap(cap)
-        out = np.full((len(q), self.n_pairs), cap)
-        narrow = np.zeros(len(q), dtype=int)
-        tf, bounds = self.placements_batch(q)
-        for i in range(len(q)):
-            for k in np.flatnonzero(bounds[i] < cap):
-                out[i, k] = min(self.pair(k, tf[i])[0], cap)
-                narrow[i] += 1
-        return out, narrow
-
-
-def _check_cap(cap) -> float:
-    try:
-        value = float(cap)
-    except (TypeError, ValueError) as e:
-        raise InputError(f"cap: expected a number (m) or inf, got {cap!r}") from e
-    if np.isnan(value) or isinstance(cap, bool):
-        raise InputError(f"cap: expected a number (m) or inf, got {cap!r}")
-    return value
 
 
 _CHECKERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

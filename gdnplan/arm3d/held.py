@@ -52,7 +52,8 @@ def hold(
     """A copy of ``robot`` holding ``shape`` (a coal shape from :mod:`gdnplan.arm3d.shapes`)
     at ``placement`` (4, 4) in ``frame`` (default: the tool frame; None placement: identity).
 
-    The copy's ``info`` records ``held`` (the object's name) and ``tool_frame``. InputError
+    The copy's ``info`` records ``held`` (the object's name), ``tool_frame`` and
+    ``held_placement`` (the (4, 4) placement in that frame). InputError
     when the robot already holds an object or the frame is unknown.
     """
     if HELD_LINK in robot.links:
@@ -76,7 +77,7 @@ def hold(
     disabled = dict(robot.disabled)
     for link in dict.fromkeys(s.link for s in robot.shapes if s.body == body):
         disabled[frozenset((link, HELD_LINK))] = "same body: the gripper holds it"
-    info = {**robot.info, "held": name, "tool_frame": frame}
+    info = {**robot.info, "held": name, "tool_frame": frame, "held_placement": tf.copy()}
     return Robot3D(robot.name, model, shapes, pairs, disabled, info)
 
 
