@@ -1,0 +1,5 @@
+"""``python -m gdnplan``: the ``gdnplan`` command (as ``python -m gdnplan.cli``)."""
+
+from .cli import main
+
+main()
