@@ -1,0 +1,296 @@
+"""The compiled kernels of :mod:`.fused_net` (numba; the math is in that module's docstring).
+
+:func:`network` loops over tiles of configurations; per tile :func:`_forward_tile` runs the
+network and keeps what the backward needs (candidates, soft weights, signs of the
+pre-activations, features, readout weights), and with the gradient :func:`_backward_tile`
+runs the reverse pass at once. Shapes: T configurations per tile, n robot nodes, C
+candidates, K layers, H features, L hidden layers of the edge MLP, R readout width.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .fused import AVAILABLE
+
+if AVAILABLE:
+    from .fused import _jit, _leaky_rows
+
+    @_jit
+    def _candidates(x, xo, cand, idx, near, lphi):
+        """idx, near (T, n, C): the C nearest obstacle nodes of every x (T, n, 2), ascending
+        d²; lphi = log max(d²_C − d², 1e-12)."""
+        t_n, n, _ = x.shape
+        m = xo.shape[0]
+        for t in range(t_n):
+            for i in range(n):
+                x0 = x[t, i, 0]
+                x1 = x[t, i, 1]
+                for c in range(cand):
+                    near[t, i, c] = np.inf
+                    idx[t, i, c] = 0
+                for j in range(m):
+                    dx = x0 - xo[j, 0]
+                    dy = x1 - xo[j, 1]
+                    dd = dx * dx + dy * dy
+                    if dd < near[t, i, cand - 1]:
+                        c = cand - 1
+                        while c > 0 and near[t, i, c - 1] > dd:
+                            near[t, i, c] = near[t, i, c - 1]
+                            idx[t, i, c] = idx[t, i, c - 1]
+                            c -= 1
+                        near[t, i, c] = dd
+                        idx[t, i, c] = j
+                for c in range(cand):
+                    lphi[t, i, c] = np.log(max(near[t, i, cand - 1] - near[t, i, c], 1e-12))
+
+    @_jit
+    def _forward_tile(x, xo, ring, tau, score, v, ax, ah, b1, wht, bh, wlt, bl3, att, h0t, hb0,
+                      hwt, hb, wlast, blast, scale, slope, st_idx, st_near, st_lphi, st_w, st_h,
+                      st_mask, st_alpha, st_ypos, st_src, st_hmask, d_out):
+        """d_out (T,) ← d̂ of the tile x (T, n, 2); the st_* buffers ← what the backward needs."""
+        t_n, n, _ = x.shape
+        layers, h = att.shape
+        cand = st_idx.shape[2]
+        rows = t_n * n
+        _candidates(x, xo, cand, st_idx, st_near, st_lphi)
+        pooled = np.empty((t_n, h), x.dtype)
+        empty = np.empty(0, x.dtype)
+        for k in range(layers):
+            w = st_w[k]
+            for t in range(t_n):  # soft weights over the candidates
+                for i in range(n):
+                    top = -np.inf
+                    for c in range(cand):
+                        lg = st_lphi[t, i, c] - st_near[t, i, c] / tau[k] + score[k, st_idx[t, i, c]]
+                        w[t, i, c] = lg
+                        top = max(top, lg)
+                    total = 0.0
+                    for c in range(cand):
+                        e = np.exp(w[t, i, c] - top)
+                        w[t, i, c] = e
+                        total += e
+                    for c in range(cand):
+                        w[t, i, c] /= total
+            if k:  # [u v] = z A_k: the h part by BLAS, the two coordinates as loops
+                uv = np.dot(st_h[k - 1, :rows], ah[k])
+            else:
+                uv = np.zeros((rows, 2 * h), x.dtype)
+            cc = np.empty((rows, h), x.dtype)
+            for t in range(t_n):
+                for i in range(n):
+                    r = t * n + i
+                    for o in range(2 * h):
+                        uv[r, o] += x[t, i, 0] * ax[k, 0, o] + x[t, i, 1] * ax[k, 1, o]
+                    for o in range(h):
+                        acc = 0.0
+                        for c in range(cand):
+                            acc += w[t, i, c] * v[k, st_idx[t, i, c], o]
+                        cc[r, o] = acc - uv[r, h + o] + b1[k, o]
+            a = np.empty((3 * rows, h), x.dtype)  # edge rows (prev, next, self) per config
+            for t in range(t_n):
+                base = 3 * n * t
+                for i in range(n):
+                    r = t * n + i
+                    jp = t * n + ring[0, i]
+                    jn = t * n + ring[1, i]
+                    for o in range(h):
+                        ci = cc[r, o] - uv[r, o]
+                        a[base + i, o] = uv[jp, o] + ci
+                        a[base + n + i, o] = uv[jn, o] + ci
+                        a[base + 2 * n + i, o] = cc[r, o]
+            _leaky_rows(a, empty, st_mask[k, 0], slope)
+            for layer in range(wht.shape[1]):
+                a = np.dot(a, wht[k, layer])
+                _leaky_rows(a, bh[k, layer], st_mask[k, layer + 1], slope)
+            msg = np.empty((rows, h), x.dtype)
+            for t in range(t_n):
+                base = 3 * n * t
+                for i in range(n):
+                    for o in range(h):
+                        msg[t * n + i, o] = a[base + i, o] + a[base + n + i, o] + a[base + 2 * n + i, o]
+            hk = st_h[k, :rows]
+            hk[:] = np.dot(msg, wlt[k])
+            for r in range(rows):
+                for o in range(h):
+                    hk[r, o] += bl3[k, o]
+            for t in range(t_n):  # readout: α = softmax_i a_kᵀ h_i, y = σ(Σ α_i h_i), max over k
+                top = -np.inf
+                for i in range(n):
+                    s = 0.0
+                    for o in range(h):
+                        s += hk[t * n + i, o] * att[k, o]
+                    st_alpha[k, t, i] = s
+                    top = max(top, s)
+                total = 0.0
+                for i in range(n):
+                    e = np.exp(st_alpha[k, t, i] - top)
+                    st_alpha[k, t, i] = e
+                    total += e
+                for i in range(n):
+                    st_alpha[k, t, i] /= total
+                for o in range(h):
+                    y = 0.0
+                    for i in range(n):
+                        y += st_alpha[k, t, i] * hk[t * n + i, o]
+                    st_ypos[k, t, o] = y > 0
+                    y = y if y > 0 else y * slope
+                    if k == 0 or y > pooled[t, o]:
+                        pooled[t, o] = y
+                        st_src[t, o] = k
+        a = np.dot(pooled, h0t)  # the head (its obstacle half is in hb0)
+        _leaky_rows(a, hb0, st_hmask[0], slope)
+        for layer in range(hwt.shape[0]):
+            a = np.dot(a, hwt[layer])
+            _leaky_rows(a, hb[layer], st_hmask[layer + 1], slope)
+        for t in range(t_n):
+            out = blast[0]
+            for o in range(a.shape[1]):
+                out += a[t, o] * wlast[o]
+            d_out[t] = out * scale
+
+    @_jit
+    def _backward_tile(x, xo, ring, tau, v, ax, aht, wh, wl, att, h0, hw, wlast, scale, slope,
+                       st_idx, st_near, st_w, st_h, st_mask, st_alpha, st_ypos, st_src, st_hmask,
+                       g_out):
+        """g_out (T, n, 2) ← ∂d̂/∂x of the tile (x normalised) from :func:`_forward_tile`'s state."""
+        t_n, n, _ = x.shape
+        layers, h = att.shape
+        cand = st_idx.shape[2]
+        rows = t_n * n
+        hl = hw.shape[0]
+        g = np.empty((t_n, wlast.shape[0]), x.dtype)
+        for t in range(t_n):
+            for o in range(wlast.shape[0]):
+                gv = wlast[o] * scale
+                g[t, o] = gv if st_hmask[hl, t, o] else gv * slope
+        for layer in range(hl - 1, -1, -1):
+            g = np.dot(g, hw[layer])
+            for t in range(t_n):
+                for o in range(g.shape[1]):
+                    if not st_hmask[layer, t, o]:
+                        g[t, o] *= slope
+        dy = np.dot(g, h0)  # (T, H): ∂/∂y_r
+        dh = np.zeros((rows, h), x.dtype)  # ∂/∂h⁽ᵏ⁾ from the layers above
+        dlphi = np.zeros((t_n, n, cand), x.dtype)
+        dnear = np.zeros((t_n, n, cand), x.dtype)
+        gy = np.empty(h, x.dtype)
+        da = np.empty(n, x.dtype)
+        for k in range(layers - 1, -1, -1):
+            hk = st_h[k]
+            for t in range(t_n):  # readout: y = σ(Σ α_i h_i), α = softmax a_kᵀ h
+                for o in range(h):
+                    gv = dy[t, o] if st_src[t, o] == k else 0.0
+                    gy[o] = gv if st_ypos[k, t, o] else gv * slope
+                mean = 0.0
+                for i in range(n):
+                    acc = 0.0
+                    for o in range(h):
+                        acc += hk[t * n + i, o] * gy[o]
+                    da[i] = acc
+                    alpha = st_alpha[k, t, i]
+                    mean += alpha * acc
+                    for o in range(h):
+                        dh[t * n + i, o] += alpha * gy[o]
+                for i in range(n):
+                    ds = st_alpha[k, t, i] * (da[i] - mean)
+                    for o in range(h):
+                        dh[t * n + i, o] += ds * att[k, o]
+            dmsg = np.dot(dh, wl[k])
+            a = np.empty((3 * rows, h), x.dtype)
+            top = st_mask[k, st_mask.shape[1] - 1]
+            for t in range(t_n):
+                base = 3 * n * t
+                for e in range(3):
+                    for i in range(n):
+                        r = base + e * n + i
+                        for o in range(h):
+                            gv = dmsg[t * n + i, o]
+                            a[r, o] = gv if top[r, o] else gv * slope
+            for layer in range(wh.shape[1] - 1, -1, -1):
+                a = np.dot(a, wh[k, layer])
+                m = st_mask[k, layer]
+                for r in range(3 * rows):
+                    for o in range(h):
+                        if not m[r, o]:
+                            a[r, o] *= slope
+            duv = np.zeros((rows, 2 * h), x.dtype)  # [∂u, ∂v], ∂v = −∂c
+            for t in range(t_n):
+                base = 3 * n * t
+                for i in range(n):
+                    r = t * n + i
+                    jp = t * n + ring[0, i]
+                    jn = t * n + ring[1, i]
+                    for o in range(h):
+                        gp = a[base + i, o]
+                        gn = a[base + n + i, o]
+                        duv[r, h + o] -= gp + gn + a[base + 2 * n + i, o]
+                        duv[r, o] -= gp + gn
+                        duv[jp, o] += gp
+                        duv[jn, o] += gn
+            w = st_w[k]
+            for t in range(t_n):  # cross weights, softmax, ∂ℓ → ∂d², ∂log φ; ∂x from z
+                for i in range(n):
+                    r = t * n + i
+                    dw = np.empty(cand, x.dtype)
+                    mean = 0.0
+                    for c in range(cand):
+                        acc = 0.0
+                        for o in range(h):
+                            acc -= duv[r, h + o] * v[k, st_idx[t, i, c], o]
+                        dw[c] = acc
+                        mean += w[t, i, c] * acc
+                    for c in range(cand):
+                        dl = w[t, i, c] * (dw[c] - mean)
+                        dlphi[t, i, c] += dl
+                        dnear[t, i, c] -= dl / tau[k]
+                    for j in range(2):
+                        acc = 0.0
+                        for o in range(2 * h):
+                            acc += duv[r, o] * ax[k, j, o]
+                        g_out[t, i, j] += acc
+            if k:
+                dh = np.dot(duv, aht[k])
+        for t in range(t_n):  # log φ, then d² = |x − x_o|²
+            for i in range(n):
+                last = st_near[t, i, cand - 1]
+                for c in range(cand - 1):
+                    delta = last - st_near[t, i, c]
+                    if delta >= 1e-12:
+                        q = dlphi[t, i, c] / delta
+                        dnear[t, i, cand - 1] += q
+                        dnear[t, i, c] -= q
+                for c in range(cand):
+                    j = st_idx[t, i, c]
+                    g_out[t, i, 0] += 2 * (x[t, i, 0] - xo[j, 0]) * dnear[t, i, c]
+                    g_out[t, i, 1] += 2 * (x[t, i, 1] - xo[j, 1]) * dnear[t, i, c]
+
+    @_jit
+    def network(x, xo, ring, tau, score, v, ax, ah, aht, b1, wht, wh, bh, wlt, wl, bl3, att,
+                h0t, h0, hb0, hwt, hw, hb, wlast, blast, cand, d_out, g_out, scale, slope, tile):
+        """d_out (B,) ← d̂ of normalised robot nodes x (B, n, 2); g_out (B, n, 2) ← ∂d̂/∂x
+        (skipped when g_out has no rows), ``tile`` configurations at a time."""
+        bsz, n, _ = x.shape
+        layers, h = att.shape
+        st_idx = np.empty((tile, n, cand), np.int64)
+        st_near = np.empty((tile, n, cand), x.dtype)
+        st_lphi = np.empty((tile, n, cand), x.dtype)
+        st_w = np.empty((layers, tile, n, cand), x.dtype)
+        st_h = np.empty((layers, tile * n, h), x.dtype)
+        st_mask = np.empty((layers, wht.shape[1] + 1, 3 * tile * n, h), np.bool_)
+        st_alpha = np.empty((layers, tile, n), x.dtype)
+        st_ypos = np.empty((layers, tile, h), np.bool_)
+        st_src = np.empty((tile, h), np.int64)
+        st_hmask = np.empty((hw.shape[0] + 1, tile, wlast.shape[0]), np.bool_)
+        grad = g_out.shape[0] > 0
+        for b0 in range(0, bsz, tile):
+            b1_ = min(b0 + tile, bsz)
+            xt = x[b0:b1_]
+            _forward_tile(xt, xo, ring, tau, score, v, ax, ah, b1, wht, bh, wlt, bl3, att, h0t,
+                          hb0, hwt, hb, wlast, blast, scale, slope, st_idx, st_near, st_lphi,
+                          st_w, st_h, st_mask, st_alpha, st_ypos, st_src, st_hmask,
+                          d_out[b0:b1_])
+            if grad:
+                _backward_tile(xt, xo, ring, tau, v, ax, aht, wh, wl, att, h0, hw, wlast, scale,
+                               slope, st_idx, st_near, st_w, st_h, st_mask, st_alpha, st_ypos,
+                               st_src, st_hmask, g_out[b0:b1_])
