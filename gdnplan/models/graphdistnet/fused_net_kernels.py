@@ -45,14 +45,47 @@ if AVAILABLE:
                     lphi[t, i, c] = np.log(max(near[t, i, cand - 1] - near[t, i, c], 1e-12))
 
     @_jit
-    def _forward_tile(x, xo, ring, tau, score, v, ax, ah, b1, wht, bh, wlt, bl3, att, h0t, hb0,
-                      hwt, hb, wlast, blast, scale, slope, st_idx, st_near, st_lphi, st_w, st_h,
-                      st_mask, st_alpha, st_ypos, st_src, st_hmask, d_out):
+    def _forward_tile(
+        x,
+        xo,
+        ring,
+        tau,
+        score,
+        v,
+        ax,
+        ah,
+        b1,
+        wht,
+        bh,
+        wlt,
+        bl3,
+        att,
+        h0t,
+        hb0,
+        hwt,
+        hb,
+        wlast,
+        blast,
+        scale,
+        slope,
+        st_idx,
+        st_near,
+        st_lphi,
+        st_w,
+        st_h,
+        st_mask,
+        st_alpha,
+        st_ypos,
+        st_src,
+        st_hmask,
+        d_out,
+    ):
         """d_out (T,) ← d̂ of the tile x (T, n, 2); the st_* buffers ← what the backward needs."""
         t_n, n, _ = x.shape
         layers, h = att.shape
         cand = st_idx.shape[2]
         rows = t_n * n
+        zero = scale * 0  # accumulators in the tile's dtype
         _candidates(x, xo, cand, st_idx, st_near, st_lphi)
         pooled = np.empty((t_n, h), x.dtype)
         empty = np.empty(0, x.dtype)
@@ -62,10 +95,11 @@ if AVAILABLE:
                 for i in range(n):
                     top = -np.inf
                     for c in range(cand):
-                        lg = st_lphi[t, i, c] - st_near[t, i, c] / tau[k] + score[k, st_idx[t, i, c]]
+                        j = st_idx[t, i, c]
+                        lg = st_lphi[t, i, c] - st_near[t, i, c] / tau[k] + score[k, j]
                         w[t, i, c] = lg
                         top = max(top, lg)
-                    total = 0.0
+                    total = zero
                     for c in range(cand):
                         e = np.exp(w[t, i, c] - top)
                         w[t, i, c] = e
@@ -83,7 +117,7 @@ if AVAILABLE:
                     for o in range(2 * h):
                         uv[r, o] += x[t, i, 0] * ax[k, 0, o] + x[t, i, 1] * ax[k, 1, o]
                     for o in range(h):
-                        acc = 0.0
+                        acc = zero
                         for c in range(cand):
                             acc += w[t, i, c] * v[k, st_idx[t, i, c], o]
                         cc[r, o] = acc - uv[r, h + o] + b1[k, o]
@@ -108,7 +142,8 @@ if AVAILABLE:
                 base = 3 * n * t
                 for i in range(n):
                     for o in range(h):
-                        msg[t * n + i, o] = a[base + i, o] + a[base + n + i, o] + a[base + 2 * n + i, o]
+                        r = base + i
+                        msg[t * n + i, o] = a[r, o] + a[r + n, o] + a[r + 2 * n, o]
             hk = st_h[k, :rows]
             hk[:] = np.dot(msg, wlt[k])
             for r in range(rows):
@@ -117,12 +152,12 @@ if AVAILABLE:
             for t in range(t_n):  # readout: α = softmax_i a_kᵀ h_i, y = σ(Σ α_i h_i), max over k
                 top = -np.inf
                 for i in range(n):
-                    s = 0.0
+                    s = zero
                     for o in range(h):
                         s += hk[t * n + i, o] * att[k, o]
                     st_alpha[k, t, i] = s
                     top = max(top, s)
-                total = 0.0
+                total = zero
                 for i in range(n):
                     e = np.exp(st_alpha[k, t, i] - top)
                     st_alpha[k, t, i] = e
@@ -130,7 +165,7 @@ if AVAILABLE:
                 for i in range(n):
                     st_alpha[k, t, i] /= total
                 for o in range(h):
-                    y = 0.0
+                    y = zero
                     for i in range(n):
                         y += st_alpha[k, t, i] * hk[t * n + i, o]
                     st_ypos[k, t, o] = y > 0
@@ -150,14 +185,39 @@ if AVAILABLE:
             d_out[t] = out * scale
 
     @_jit
-    def _backward_tile(x, xo, ring, tau, v, ax, aht, wh, wl, att, h0, hw, wlast, scale, slope,
-                       st_idx, st_near, st_w, st_h, st_mask, st_alpha, st_ypos, st_src, st_hmask,
-                       g_out):
+    def _backward_tile(
+        x,
+        xo,
+        ring,
+        tau,
+        v,
+        ax,
+        aht,
+        wh,
+        wl,
+        att,
+        h0,
+        hw,
+        wlast,
+        scale,
+        slope,
+        st_idx,
+        st_near,
+        st_w,
+        st_h,
+        st_mask,
+        st_alpha,
+        st_ypos,
+        st_src,
+        st_hmask,
+        g_out,
+    ):
         """g_out (T, n, 2) ← ∂d̂/∂x of the tile (x normalised) from :func:`_forward_tile`'s state."""
         t_n, n, _ = x.shape
         layers, h = att.shape
         cand = st_idx.shape[2]
         rows = t_n * n
+        zero = scale * 0
         hl = hw.shape[0]
         g = np.empty((t_n, wlast.shape[0]), x.dtype)
         for t in range(t_n):
@@ -180,11 +240,11 @@ if AVAILABLE:
             hk = st_h[k]
             for t in range(t_n):  # readout: y = σ(Σ α_i h_i), α = softmax a_kᵀ h
                 for o in range(h):
-                    gv = dy[t, o] if st_src[t, o] == k else 0.0
+                    gv = dy[t, o] if st_src[t, o] == k else zero
                     gy[o] = gv if st_ypos[k, t, o] else gv * slope
-                mean = 0.0
+                mean = zero
                 for i in range(n):
-                    acc = 0.0
+                    acc = zero
                     for o in range(h):
                         acc += hk[t * n + i, o] * gy[o]
                     da[i] = acc
@@ -233,9 +293,9 @@ if AVAILABLE:
                 for i in range(n):
                     r = t * n + i
                     dw = np.empty(cand, x.dtype)
-                    mean = 0.0
+                    mean = zero
                     for c in range(cand):
-                        acc = 0.0
+                        acc = zero
                         for o in range(h):
                             acc -= duv[r, h + o] * v[k, st_idx[t, i, c], o]
                         dw[c] = acc
@@ -245,7 +305,7 @@ if AVAILABLE:
                         dlphi[t, i, c] += dl
                         dnear[t, i, c] -= dl / tau[k]
                     for j in range(2):
-                        acc = 0.0
+                        acc = zero
                         for o in range(2 * h):
                             acc += duv[r, o] * ax[k, j, o]
                         g_out[t, i, j] += acc
@@ -266,8 +326,39 @@ if AVAILABLE:
                     g_out[t, i, 1] += 2 * (x[t, i, 1] - xo[j, 1]) * dnear[t, i, c]
 
     @_jit
-    def network(x, xo, ring, tau, score, v, ax, ah, aht, b1, wht, wh, bh, wlt, wl, bl3, att,
-                h0t, h0, hb0, hwt, hw, hb, wlast, blast, cand, d_out, g_out, scale, slope, tile):
+    def network(
+        x,
+        xo,
+        ring,
+        tau,
+        score,
+        v,
+        ax,
+        ah,
+        aht,
+        b1,
+        wht,
+        wh,
+        bh,
+        wlt,
+        wl,
+        bl3,
+        att,
+        h0t,
+        h0,
+        hb0,
+        hwt,
+        hw,
+        hb,
+        wlast,
+        blast,
+        cand,
+        d_out,
+        g_out,
+        scale,
+        slope,
+        tile,
+    ):
         """d_out (B,) ← d̂ of normalised robot nodes x (B, n, 2); g_out (B, n, 2) ← ∂d̂/∂x
         (skipped when g_out has no rows), ``tile`` configurations at a time."""
         bsz, n, _ = x.shape
@@ -286,11 +377,66 @@ if AVAILABLE:
         for b0 in range(0, bsz, tile):
             b1_ = min(b0 + tile, bsz)
             xt = x[b0:b1_]
-            _forward_tile(xt, xo, ring, tau, score, v, ax, ah, b1, wht, bh, wlt, bl3, att, h0t,
-                          hb0, hwt, hb, wlast, blast, scale, slope, st_idx, st_near, st_lphi,
-                          st_w, st_h, st_mask, st_alpha, st_ypos, st_src, st_hmask,
-                          d_out[b0:b1_])
+            _forward_tile(
+                xt,
+                xo,
+                ring,
+                tau,
+                score,
+                v,
+                ax,
+                ah,
+                b1,
+                wht,
+                bh,
+                wlt,
+                bl3,
+                att,
+                h0t,
+                hb0,
+                hwt,
+                hb,
+                wlast,
+                blast,
+                scale,
+                slope,
+                st_idx,
+                st_near,
+                st_lphi,
+                st_w,
+                st_h,
+                st_mask,
+                st_alpha,
+                st_ypos,
+                st_src,
+                st_hmask,
+                d_out[b0:b1_],
+            )
             if grad:
-                _backward_tile(xt, xo, ring, tau, v, ax, aht, wh, wl, att, h0, hw, wlast, scale,
-                               slope, st_idx, st_near, st_w, st_h, st_mask, st_alpha, st_ypos,
-                               st_src, st_hmask, g_out[b0:b1_])
+                _backward_tile(
+                    xt,
+                    xo,
+                    ring,
+                    tau,
+                    v,
+                    ax,
+                    aht,
+                    wh,
+                    wl,
+                    att,
+                    h0,
+                    hw,
+                    wlast,
+                    scale,
+                    slope,
+                    st_idx,
+                    st_near,
+                    st_w,
+                    st_h,
+                    st_mask,
+                    st_alpha,
+                    st_ypos,
+                    st_src,
+                    st_hmask,
+                    g_out[b0:b1_],
+                )

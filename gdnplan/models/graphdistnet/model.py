@@ -18,6 +18,7 @@ from ...scene import Scene
 from ..checks import check_fits
 from ..threads import check_threads, torch_threads
 from . import fused as fused_kernel
+from . import fused_net
 from .lean import SceneGraph
 from .network import GraphDistNet
 
@@ -44,7 +45,9 @@ class GraphDistNetModel:
     (:mod:`.fused`: on CPU, hidden layers of one width, numba installed), False the
     torch reference (:class:`~.layers._LeakyRingMessages`), None (default) the fused kernels
     where they serve the network, else the reference. The two compute the same function
-    (tests/test_graphdistnet_fused.py).
+    (tests/test_graphdistnet_fused.py). With the fused kernels, one-way networks that
+    :func:`.fused_net.serves` run whole in one compiled pass (:mod:`.fused_net`: d̂ and
+    ∂d̂/∂nodes without torch; tests/test_graphdistnet_fused_net.py).
     """
 
     name = "graphdistnet"
@@ -101,7 +104,10 @@ class GraphDistNetModel:
             lean = (
                 self.net.scene_graph(graph, obstacles) if self.config.cross == "soft_knn" else None
             )
-            cached = self._scenes[scene] = _SceneCache(graph, obstacles, lean)
+            whole = None
+            if self.fused and fused_net.serves(self.config):
+                whole = fused_net.pack(self.net, lean, _NUMPY[self.dtype])
+            cached = self._scenes[scene] = _SceneCache(graph, obstacles, lean, whole)
         return cached
 
     def _estimate(
@@ -136,6 +142,9 @@ class GraphDistNetModel:
         q = scene.robot.check_q(q)
         with torch_threads(self.threads):
             graphs = self._graphs(scene)  # outside inference mode: the cache serves autograd too
+            if graphs.whole is not None:
+                d, _ = fused_net.run(graphs.whole, graphs.robot.positions(q), grad=False)
+                return d.astype(np.float64)
             gen = self._generator()
             with torch.inference_mode():
                 out = [
@@ -149,6 +158,8 @@ class GraphDistNetModel:
         q = scene.robot.check_q(q)
         with torch_threads(self.threads):
             graphs = self._graphs(scene)
+            if graphs.whole is not None:
+                return _whole(graphs, q)
             gen = self._generator()
             ds, gs = [], []
             for part in self._chunks(len(q), graphs):
@@ -171,6 +182,9 @@ class GraphDistNetModel:
         threads = self.threads
         with torch_threads(threads):
             graphs = self._graphs(scene)
+            if graphs.whole is not None:  # the compiled pass: d̂ now, d̂ and ∂d̂ again if asked
+                d, _ = fused_net.run(graphs.whole, graphs.robot.positions(q), grad=False)
+                return d.astype(np.float64), functools.cache(lambda: _whole(graphs, q)[1])
             gen = self._generator()
             tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
 
@@ -208,11 +222,23 @@ class _Tape:
 
 @dataclass(frozen=True)
 class _SceneCache:
-    """The graphs of one scene: robot structure, obstacle graph (1, N_o), lean constants."""
+    """The graphs of one scene: robot structure, obstacle graph (1, N_o), lean constants and,
+    where :mod:`.fused_net` serves, the packed arrays of its whole-network pass."""
 
     robot: RobotGraph
     obstacles: GraphBatch
     lean: SceneGraph | None
+    whole: fused_net.OneWayWeights | None = None
+
+
+_NUMPY = {torch.float32: np.float32, torch.float64: np.float64}
+
+
+def _whole(graphs: _SceneCache, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(d̂ (B,), ∂d̂/∂q (B, dof)) of q by the whole-network pass and the robot's pullback."""
+    nodes, joints = graphs.robot.kinematics(q)
+    d, dx = fused_net.run(graphs.whole, nodes, grad=True)
+    return d.astype(np.float64), graphs.robot.pullback(nodes, joints, dx.astype(np.float64))
 
 
 def _repeat(graph: GraphBatch, b: int) -> GraphBatch:
