@@ -176,15 +176,19 @@ class GraphDistNetModel:
         The forward pass keeps its autograd graph; the backward pass runs only if the gradient
         is asked for (then once). A line search evaluates trial points it often rejects: they
         cost the forward pass alone (about half of :meth:`distance_and_grad`). Meant for
-        planner-sized batches: every chunk's graph is held until the gradient is taken.
+        planner-sized batches: every chunk's graph is held until the gradient is taken. The
+        whole-network pass (:mod:`.fused_net`) computes the gradient with d̂ instead: its
+        backward follows each tile's forward in cache (about half the forward's cost again),
+        cheaper than a second forward for the 70 % or so of planner calls that ask for it
+        (docs/decisions.md, 2026-12-02 fused2).
         """
         q = scene.robot.check_q(q)
         threads = self.threads
         with torch_threads(threads):
             graphs = self._graphs(scene)
-            if graphs.whole is not None:  # the compiled pass: d̂ now, d̂ and ∂d̂ again if asked
-                d, _ = fused_net.run(graphs.whole, graphs.robot.positions(q), grad=False)
-                return d.astype(np.float64), functools.cache(lambda: _whole(graphs, q)[1])
+            if graphs.whole is not None:  # the compiled pass: its gradient at once (below)
+                d, g = _whole(graphs, q)
+                return d, lambda: g
             gen = self._generator()
             tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
 
