@@ -236,6 +236,7 @@ if AVAILABLE:
         dnear = np.zeros((t_n, n, cand), x.dtype)
         gy = np.empty(h, x.dtype)
         da = np.empty(n, x.dtype)
+        dw = np.empty(cand, x.dtype)
         for k in range(layers - 1, -1, -1):
             hk = st_h[k]
             for t in range(t_n):  # readout: y = σ(Σ α_i h_i), α = softmax a_kᵀ h
@@ -292,7 +293,6 @@ if AVAILABLE:
             for t in range(t_n):  # cross weights, softmax, ∂ℓ → ∂d², ∂log φ; ∂x from z
                 for i in range(n):
                     r = t * n + i
-                    dw = np.empty(cand, x.dtype)
                     mean = zero
                     for c in range(cand):
                         acc = zero
