@@ -44,7 +44,7 @@ def network_flops(x, xo, ring, tau, score, v, ax, ah, aht, b1, wht, *rest) -> in
     head; the backward (when g_out has rows) the same again."""
     hw, wlast, cand, g_out = rest[-10], rest[-8], rest[-6], rest[-4]
     b, n, _ = x.shape
-    k, _, h = ax.shape
+    k, h = ax.shape[0], ax.shape[2] // 2
     layer = 6 * n * wht.shape[1] * h * h + 2 * n * h * h + 8 * n * h + 2 * n * cand * h + 4 * n * h
     forward = k * layer + (k - 1) * 4 * n * h * h + 2 * (h * hw.shape[1] + hw.size + len(wlast))
     return b * forward * (2 if g_out.shape[0] else 1)
