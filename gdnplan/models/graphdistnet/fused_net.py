@@ -103,8 +103,6 @@ def pack(net, scene, dtype: np.dtype) -> OneWayWeights:
     whs, wls, ahs = torch.stack(wh), torch.stack(wl), torch.stack(ah)
     n_r = len(scene.robot_ring) // 2
     arrays = [
-        scene.obstacles,
-        scene.robot_ring.view(2, n_r),
         net.log_tau.exp(),
         fixed.score,
         fixed.v,
@@ -128,8 +126,8 @@ def pack(net, scene, dtype: np.dtype) -> OneWayWeights:
         head[-1].weight[0],
         head[-1].bias,
     ]
-    packed = [_np(t, dtype) for t in arrays]
-    packed[1] = np.ascontiguousarray(scene.robot_ring.view(2, n_r).numpy().astype(np.int64))
+    ring = np.ascontiguousarray(scene.robot_ring.view(2, n_r).cpu().numpy().astype(np.int64))
+    packed = [_np(scene.obstacles, dtype), ring, *(_np(t, dtype) for t in arrays)]
     cand = min(c.cross_k + 1, len(scene.obstacles))
     return OneWayWeights(tuple(packed), np.asarray(c.origin, dtype), float(c.scale), cand)
 
