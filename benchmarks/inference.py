@@ -6,12 +6,14 @@ UR5e ``fetch`` scene uses ``ur5e.safetensors``), on one scene (seed 0) and the s
 random configurations: coal distance and distance + exact gradient (bounding-circle broad
 phase, batches split over all cores by processes) and GraphDistNet distance and distance +
 ∂d̂/∂q (float32, ``--threads`` torch threads) by the torch reference path (``fused=False``)
-and by the fused kernels (``fused=True``, models/graphdistnet/fused.py), best of the repeats
+and by the fused kernels (``fused=True``: models/graphdistnet/fused.py, and for one-way networks
+the whole-network pass of models/graphdistnet/fused_net.py), best of the repeats
 after one warm-up call each, all six interleaved round by round.
 
 FLOPs: the matmul FLOPs torch runs (FlopCounterMode) plus the fused kernels' products (2 R H²
 per hidden layer of the edge MLP on R edge rows, forward and backward; 2 n C H for the sparse
-cross mix), counted by wrapping the kernels. Reported: GFLOP/s of the fused kernels alone
+cross mix; :func:`network_flops` for the whole-network pass), counted by wrapping them.
+Reported: GFLOP/s of the fused kernels alone
 (their FLOPs over their thread CPU seconds) and of the whole fused distance + gradient pass
 (all its FLOPs over its best thread CPU seconds), each as a share of a 2048² float32 matmul
 on this thread (thread CPU seconds too: the machine is shared, CPU time is what a busy core
@@ -32,13 +34,28 @@ from torch.utils.flop_counter import FlopCounterMode
 import gdnplan as gp
 from gdnplan import distance
 from gdnplan.assets import default_weights
-from gdnplan.models.graphdistnet import fused
+from gdnplan.models.graphdistnet import fused, fused_net
 
-KERNELS = {  # fused.py's compiled functions: FLOPs of one call from its arguments
-    "_forward": lambda u, c, ring, wt, *_: 2 * u.shape[0] * 3 * u.shape[1] * wt.size,
-    "_backward": lambda g, ring, w, *_: 2 * g.shape[0] * 3 * g.shape[1] * w.size,
-    "_mix_forward": lambda w, idx, v, out: 2 * w.size * v.shape[1],
-    "_mix_backward": lambda g, idx, v, dw: 2 * idx.size * v.shape[1],
+
+def network_flops(x, xo, ring, tau, score, v, ax, ah, aht, b1, wht, *rest) -> int:
+    """Product FLOPs of one whole-network call (fused_net): per configuration and layer the
+    edge MLP 2·3n·L·H², the last linear layer 2·n·H², the first 2·n·2·2H (coordinates) +
+    2·n·H·2H (features, layers ≥ 1), the cross mix 2·n·C·H and the readout 4·n·H, plus the
+    head; the backward (when g_out has rows) the same again."""
+    hw, wlast, cand, g_out = rest[-10], rest[-8], rest[-6], rest[-4]
+    b, n, _ = x.shape
+    k, h = ax.shape[0], ax.shape[2] // 2
+    layer = 6 * n * wht.shape[1] * h * h + 2 * n * h * h + 8 * n * h + 2 * n * cand * h + 4 * n * h
+    forward = k * layer + (k - 1) * 4 * n * h * h + 2 * (h * hw.shape[1] + hw.size + len(wlast))
+    return b * forward * (2 if g_out.shape[0] else 1)
+
+
+KERNELS = {  # the compiled functions (module, name): FLOPs of one call from its arguments
+    (fused, "_forward"): lambda u, c, ring, wt, *_: 2 * u.shape[0] * 3 * u.shape[1] * wt.size,
+    (fused, "_backward"): lambda g, ring, w, *_: 2 * g.shape[0] * 3 * g.shape[1] * w.size,
+    (fused, "_mix_forward"): lambda w, idx, v, out: 2 * w.size * v.shape[1],
+    (fused, "_mix_backward"): lambda g, idx, v, dw: 2 * idx.size * v.shape[1],
+    (fused_net._kernels, "network"): network_flops,
 }
 
 
@@ -61,26 +78,26 @@ def matmul_gflops(size: int = 2048, repeats: int = 5) -> float:
 
 def metered(call: Callable[[], object]) -> tuple[int, int, float]:
     """(torch matmul FLOPs, kernel FLOPs, kernel thread CPU seconds) of one ``call``."""
-    originals = {name: getattr(fused, name) for name in KERNELS}
+    originals = {key: getattr(*key) for key in KERNELS}
     kernel = {"flops": 0, "seconds": 0.0}
 
-    def wrap(name: str):
+    def wrap(key: tuple):
         def run(*args):
             start = time.thread_time()
-            originals[name](*args)
+            originals[key](*args)
             kernel["seconds"] += time.thread_time() - start
-            kernel["flops"] += KERNELS[name](*args)
+            kernel["flops"] += KERNELS[key](*args)
 
         return run
 
     try:
-        for name in KERNELS:
-            setattr(fused, name, wrap(name))
+        for key in KERNELS:
+            setattr(*key, wrap(key))
         with FlopCounterMode(display=False) as counter:
             call()
     finally:
-        for name, original in originals.items():
-            setattr(fused, name, original)
+        for (module, name), original in originals.items():
+            setattr(module, name, original)
     return counter.get_total_flops(), kernel["flops"], kernel["seconds"]
 
 

@@ -18,6 +18,7 @@ from ...scene import Scene
 from ..checks import check_fits
 from ..threads import check_threads, torch_threads
 from . import fused as fused_kernel
+from . import fused_net
 from .lean import SceneGraph
 from .network import GraphDistNet
 
@@ -44,7 +45,9 @@ class GraphDistNetModel:
     (:mod:`.fused`: on CPU, hidden layers of one width, numba installed), False the
     torch reference (:class:`~.layers._LeakyRingMessages`), None (default) the fused kernels
     where they serve the network, else the reference. The two compute the same function
-    (tests/test_graphdistnet_fused.py).
+    (tests/test_graphdistnet_fused.py). With the fused kernels, one-way networks that
+    :func:`.fused_net.serves` run whole in one compiled pass (:mod:`.fused_net`: d̂ and
+    ∂d̂/∂nodes without torch; tests/test_graphdistnet_fused_net.py).
     """
 
     name = "graphdistnet"
@@ -101,7 +104,10 @@ class GraphDistNetModel:
             lean = (
                 self.net.scene_graph(graph, obstacles) if self.config.cross == "soft_knn" else None
             )
-            cached = self._scenes[scene] = _SceneCache(graph, obstacles, lean)
+            whole = None
+            if self.fused and fused_net.serves(self.config):
+                whole = fused_net.pack(self.net, lean, _NUMPY[self.dtype])
+            cached = self._scenes[scene] = _SceneCache(graph, obstacles, lean, whole)
         return cached
 
     def _estimate(
@@ -136,6 +142,9 @@ class GraphDistNetModel:
         q = scene.robot.check_q(q)
         with torch_threads(self.threads):
             graphs = self._graphs(scene)  # outside inference mode: the cache serves autograd too
+            if graphs.whole is not None:
+                d, _ = fused_net.run(graphs.whole, graphs.robot.positions(q), grad=False)
+                return d.astype(np.float64)
             gen = self._generator()
             with torch.inference_mode():
                 out = [
@@ -149,6 +158,8 @@ class GraphDistNetModel:
         q = scene.robot.check_q(q)
         with torch_threads(self.threads):
             graphs = self._graphs(scene)
+            if graphs.whole is not None:
+                return _whole(graphs, q)
             gen = self._generator()
             ds, gs = [], []
             for part in self._chunks(len(q), graphs):
@@ -165,12 +176,19 @@ class GraphDistNetModel:
         The forward pass keeps its autograd graph; the backward pass runs only if the gradient
         is asked for (then once). A line search evaluates trial points it often rejects: they
         cost the forward pass alone (about half of :meth:`distance_and_grad`). Meant for
-        planner-sized batches: every chunk's graph is held until the gradient is taken.
+        planner-sized batches: every chunk's graph is held until the gradient is taken. The
+        whole-network pass (:mod:`.fused_net`) computes the gradient with d̂ instead: its
+        backward follows each tile's forward in cache (about half the forward's cost again),
+        cheaper than a second forward for the 70 % or so of planner calls that ask for it
+        (docs/decisions.md, 2026-12-02 fused2).
         """
         q = scene.robot.check_q(q)
         threads = self.threads
         with torch_threads(threads):
             graphs = self._graphs(scene)
+            if graphs.whole is not None:  # the compiled pass: its gradient at once (below)
+                d, g = _whole(graphs, q)
+                return d, lambda: g
             gen = self._generator()
             tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
 
@@ -208,11 +226,23 @@ class _Tape:
 
 @dataclass(frozen=True)
 class _SceneCache:
-    """The graphs of one scene: robot structure, obstacle graph (1, N_o), lean constants."""
+    """The graphs of one scene: robot structure, obstacle graph (1, N_o), lean constants and,
+    where :mod:`.fused_net` serves, the packed arrays of its whole-network pass."""
 
     robot: RobotGraph
     obstacles: GraphBatch
     lean: SceneGraph | None
+    whole: fused_net.OneWayWeights | None = None
+
+
+_NUMPY = {torch.float32: np.float32, torch.float64: np.float64}
+
+
+def _whole(graphs: _SceneCache, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(d̂ (B,), ∂d̂/∂q (B, dof)) of q by the whole-network pass and the robot's pullback."""
+    nodes, joints = graphs.robot.kinematics(q)
+    d, dx = fused_net.run(graphs.whole, nodes, grad=True)
+    return d.astype(np.float64), graphs.robot.pullback(nodes, joints, dx.astype(np.float64))
 
 
 def _repeat(graph: GraphBatch, b: int) -> GraphBatch:
