@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 
@@ -25,7 +27,7 @@ def dense_min(scene, q: np.ndarray, n: int = 400) -> float:
     """Smallest coal distance at n points per segment of q (T, dof): independent of the
     certificate's bisection."""
     s = np.linspace(0.0, 1.0, n)[:, None]
-    return float(min(signed_distance(scene, a + s * (b - a)).min() for a, b in zip(q, q[1:])))
+    return float(min(signed_distance(scene, a + s * (b - a)).min() for a, b in pairwise(q)))
 
 
 def unpolished(square, margin: float = 0.02):
