@@ -21,6 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..limits import MAX_REFINE_ROUNDS
 from ..models import DistanceModel
 from .config import PlanConfig
 from .problem import Problem
@@ -31,6 +32,7 @@ log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the st
 # the polish solves in turn: (check points' buffer above c (m), check points added per
 # segment, obj_change_tol)
 POLISH_STAGES = ((0.0005, 1, 1e-5), (0.0002, 2, 1e-6))
+EXTRA_ROUNDS = 3  # refine rounds a polish or repair solve gets beyond RefineConfig.rounds
 REPAIR_EXTRA = 2  # check points per segment the repair adds
 REPAIR_BUFFER = 0.003  # m: extra bound of the repair's check points
 
@@ -70,12 +72,13 @@ def polish(
     if run.seed is None or run.seed.kind == "straight":
         return
     opt, first = cfg.optimizer, path_cost(run.q)
+    rounds = min(cfg.refine.rounds + EXTRA_ROUNDS, MAX_REFINE_ROUNDS)
     for buffer, extra, stop in POLISH_STAGES:
         if run.verified is None or not run.verified.ok or time.perf_counter() >= deadline:
             return
         tight = replace(
             cfg,
-            refine=replace(cfg.refine, clearance_buffer=buffer),
+            refine=replace(cfg.refine, clearance_buffer=buffer, rounds=rounds),
             optimizer=replace(opt, interpolated=opt.interpolated + extra, obj_change_tol=stop),
         )
         t0, before, cert = time.perf_counter(), path_cost(run.q), run.verified
@@ -110,9 +113,10 @@ def repair(
     if time.perf_counter() >= deadline:
         return
     opt, ref = cfg.optimizer, cfg.refine
+    rounds = min(ref.rounds + EXTRA_ROUNDS, MAX_REFINE_ROUNDS)
     wide = replace(
         cfg,
-        refine=replace(ref, clearance_buffer=ref.clearance_buffer + REPAIR_BUFFER),
+        refine=replace(ref, clearance_buffer=ref.clearance_buffer + REPAIR_BUFFER, rounds=rounds),
         optimizer=replace(opt, interpolated=opt.interpolated + REPAIR_EXTRA),
     )
     t0 = time.perf_counter()
