@@ -33,6 +33,10 @@ def square():
     return gp.make_scene("a")
 
 
+# the seeds' solves alone, without the polish and repair solves after them (gdnplan.trajopt.polish)
+SEEDS_ONLY = {"polish": False, "repair": False}
+
+
 def test_straight_line_of_the_test_problem_collides(square):
     ok, dmin = verify_path(square, straight_line(np.array(START), np.array(GOAL), 10))
     assert not ok and dmin < 0
@@ -55,7 +59,9 @@ def test_ipopt_solves_planar2_around_a_square_with_coal(square):
 def test_extra_ipopt_options_reach_the_solver(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     cfg = PlanConfig(
-        SeedConfig(starts=1, count=1), RefineConfig(ccd=False), IpoptConfig(options={"max_iter": 2})
+        SeedConfig(starts=1, count=1),
+        RefineConfig(ccd=False, polish=False),
+        IpoptConfig(options={"max_iter": 2}),
     )
     result = plan(p, collision="coal", solver=cfg)
     assert result.iterations == 2 and result.status == "Maximum_Iterations_Exceeded"
@@ -282,7 +288,9 @@ def test_check_points_per_segment_follow_the_solver_default(square, solver, inte
     model = _BatchSizes()
     kind = {"ipopt": IpoptConfig, "adam": AdamConfig}[solver]
     optimizer = kind() if interpolated is None else kind(interpolated=interpolated)
-    opts = PlanConfig(SeedConfig(initial="rrt", starts=1), RefineConfig(rounds=0), optimizer)
+    opts = PlanConfig(
+        SeedConfig(initial="rrt", starts=1), RefineConfig(rounds=0, **SEEDS_ONLY), optimizer
+    )
     plan(p, collision=model, solver=opts)
     inner = (p.waypoints - 1) * (points + 1) - 1  # Ipopt has no rows at start and goal
     assert model.sizes[-1] == (inner if solver == "ipopt" else inner + 2)
@@ -318,7 +326,7 @@ class _Liar(_BatchSizes):
 def test_each_restart_adds_a_check_point_per_segment(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     model = _Liar()
-    opts = PlanConfig(SeedConfig(initial="rrt", starts=3), RefineConfig(rounds=0))
+    opts = PlanConfig(SeedConfig(initial="rrt", starts=3), RefineConfig(rounds=0, **SEEDS_ONLY))
     result = plan(p, collision=model, solver=opts)
     assert not result.success and result.attempts == 3
     batches = list(dict.fromkeys(model.sizes))  # distinct NLP sizes, in order
@@ -346,7 +354,7 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
 
     monkeypatch.setattr(trajopt._Transcription, "__init__", record)
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
-    refine = RefineConfig(rounds=1, raise_window=1, exact_rows=False)
+    refine = RefineConfig(rounds=1, raise_window=1, exact_rows=False, **SEEDS_ONLY)
     opts = PlanConfig(SeedConfig(initial="rrt", starts=1), refine)
     assert not plan(p, collision=_Liar(), solver=opts).success
     (_, first), (splits, second) = margins
@@ -375,7 +383,7 @@ def test_refine_rounds_raise_to_the_overestimate_not_its_sum(square, monkeypatch
 
     monkeypatch.setattr(trajopt._Transcription, "__init__", record)
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
-    refine = RefineConfig(rounds=2, raise_window=None, exact_rows=False)
+    refine = RefineConfig(rounds=2, raise_window=None, exact_rows=False, **SEEDS_ONLY)
     opts = PlanConfig(SeedConfig(initial="rrt", starts=1), refine)
     assert not plan(p, collision=_Liar(), solver=opts).success
     base = trajopt.check_points.constraint_margin(p, refine.clearance_buffer)
