@@ -1,11 +1,12 @@
 """gdnplan against OMPL's planners on the Table II problems, one validity rule and one certificate.
 
-Usage: python benchmarks/ompl_compare.py --threads 1 [--envs b d fetch] [--problems N]
+Usage: python benchmarks/ompl_compare.py --threads 1 [--envs b d fetch] [--problems N] [--first K]
        [--budgets [1 3]] [--planners rrtconnect bitstar aorrtc] [--seeds N] [--kinds rrt …]
        [--out benchmarks/results/…]
 
-Problems: the first N of the 20 Table II problems of each setting
-(:func:`gdnplan.table2.reaching_problems`: (b), (d) and the fetch layouts, seed 0).
+Problems: N of the 20 Table II problems of each setting from problem K on (default: all 20)
+(:func:`gdnplan.table2.reaching_problems`: (b), (d) and the fetch layouts, seed 0); runs on
+disjoint ranges can be merged with ``--render``.
 Methods, on every problem in one run:
 
 - gdnplan, ``gp.plan(problem)`` with its defaults (``--seeds`` / ``--kinds`` change the seed
@@ -237,6 +238,7 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=1, help="torch threads")
     parser.add_argument("--envs", nargs="+", default=["b", "d", "fetch"])
     parser.add_argument("--problems", type=int, default=20)
+    parser.add_argument("--first", type=int, default=0, help="index of the first problem")
     parser.add_argument("--budgets", nargs="*", type=float, default=[1.0, 3.0])
     parser.add_argument("--planners", nargs="+", default=["rrtconnect", "bitstar", "aorrtc"])
     parser.add_argument("--seed", type=int, default=0, help="OMPL's random seed")
@@ -267,7 +269,8 @@ def main() -> None:
     head = header(command)  # the date the run started
     for env in args.envs:
         model = gp.load_model(WEIGHTS_ENV[env])
-        for i, problem in enumerate(reaching_problems(env, n=args.problems)):
+        problems = reaching_problems(env, n=args.first + args.problems)[args.first :]
+        for i, problem in enumerate(problems, start=args.first):
             recs = run_problem(env, i, problem, model, args)
             records += recs
             with jsonl.open("a") as f:

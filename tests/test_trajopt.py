@@ -33,6 +33,10 @@ def square():
     return gp.make_scene("a")
 
 
+# the seeds' solves alone, without the polish and repair solves after them (gdnplan.trajopt.polish)
+SEEDS_ONLY = {"polish": False, "repair": False}
+
+
 def test_straight_line_of_the_test_problem_collides(square):
     ok, dmin = verify_path(square, straight_line(np.array(START), np.array(GOAL), 10))
     assert not ok and dmin < 0
@@ -46,14 +50,18 @@ def test_ipopt_solves_planar2_around_a_square_with_coal(square):
     assert result.iterations > 0 and result.model_calls > 0
     assert result.q.shape == (10, 2)
     np.testing.assert_allclose(result.q[[0, -1]], [START, GOAL])
-    ok, dmin = verify_path(square, result.q)
-    assert ok and dmin > 0 and result.min_distance == pytest.approx(dmin)
+    ok, dmin = verify_path(square, result.q)  # at margin 0: another bisection, within 1 mm
+    assert ok and dmin > 0 and result.min_distance == pytest.approx(dmin, abs=1e-3)
+    same = verify_path(square, result.q, margin=p.certified_clearance)  # the plan's certificate
+    assert same[0] and result.min_distance == pytest.approx(same[1])
 
 
 def test_extra_ipopt_options_reach_the_solver(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     cfg = PlanConfig(
-        SeedConfig(starts=1, count=1), RefineConfig(ccd=False), IpoptConfig(options={"max_iter": 2})
+        SeedConfig(starts=1, count=1),
+        RefineConfig(ccd=False, polish=False),
+        IpoptConfig(options={"max_iter": 2}),
     )
     result = plan(p, collision="coal", solver=cfg)
     assert result.iterations == 2 and result.status == "Maximum_Iterations_Exceeded"
@@ -280,7 +288,9 @@ def test_check_points_per_segment_follow_the_solver_default(square, solver, inte
     model = _BatchSizes()
     kind = {"ipopt": IpoptConfig, "adam": AdamConfig}[solver]
     optimizer = kind() if interpolated is None else kind(interpolated=interpolated)
-    opts = PlanConfig(SeedConfig(initial="rrt", starts=1), RefineConfig(rounds=0), optimizer)
+    opts = PlanConfig(
+        SeedConfig(initial="rrt", starts=1), RefineConfig(rounds=0, **SEEDS_ONLY), optimizer
+    )
     plan(p, collision=model, solver=opts)
     inner = (p.waypoints - 1) * (points + 1) - 1  # Ipopt has no rows at start and goal
     assert model.sizes[-1] == (inner if solver == "ipopt" else inner + 2)
@@ -316,7 +326,7 @@ class _Liar(_BatchSizes):
 def test_each_restart_adds_a_check_point_per_segment(square):
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
     model = _Liar()
-    opts = PlanConfig(SeedConfig(initial="rrt", starts=3), RefineConfig(rounds=0))
+    opts = PlanConfig(SeedConfig(initial="rrt", starts=3), RefineConfig(rounds=0, **SEEDS_ONLY))
     result = plan(p, collision=model, solver=opts)
     assert not result.success and result.attempts == 3
     batches = list(dict.fromkeys(model.sizes))  # distinct NLP sizes, in order
@@ -344,7 +354,7 @@ def test_refine_round_raises_the_margin_only_near_rejected_segments(square, monk
 
     monkeypatch.setattr(trajopt._Transcription, "__init__", record)
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
-    refine = RefineConfig(rounds=1, raise_window=1, exact_rows=False)
+    refine = RefineConfig(rounds=1, raise_window=1, exact_rows=False, **SEEDS_ONLY)
     opts = PlanConfig(SeedConfig(initial="rrt", starts=1), refine)
     assert not plan(p, collision=_Liar(), solver=opts).success
     (_, first), (splits, second) = margins
@@ -373,7 +383,7 @@ def test_refine_rounds_raise_to_the_overestimate_not_its_sum(square, monkeypatch
 
     monkeypatch.setattr(trajopt._Transcription, "__init__", record)
     p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
-    refine = RefineConfig(rounds=2, raise_window=None, exact_rows=False)
+    refine = RefineConfig(rounds=2, raise_window=None, exact_rows=False, **SEEDS_ONLY)
     opts = PlanConfig(SeedConfig(initial="rrt", starts=1), refine)
     assert not plan(p, collision=_Liar(), solver=opts).success
     base = trajopt.check_points.constraint_margin(p, refine.clearance_buffer)

@@ -31,7 +31,10 @@ straight line when it is certified free (then it is already optimal and returned
 from seed paths (:mod:`gdnplan.trajopt.seeds`: RRT-Connect, a via point, or any registered
 kind), replacing a seed whose path ends uncertified; with ``SeedConfig.count`` > 1 (or a
 ``time_budget``) it refines several seeds and returns the certified path of least path cost.
-A plan succeeds only when
+Then (:mod:`gdnplan.trajopt.polish`) the polish re-solves from that path with tighter stops,
+more check points and buffers of 0.5 and 0.2 mm, each result kept when certified and cheaper;
+when no seed was certified, the repair re-solves from the last path with more check points and
+a wider buffer. A plan succeeds only when
 :func:`gdnplan.ccd.certify_path` proves with coal that the whole returned path keeps d > c
 (``Plan.min_distance`` is that proven bound) and the goal is reached — never on the solver's
 word alone.

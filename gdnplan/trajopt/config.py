@@ -148,6 +148,11 @@ class RefineConfig:
         exact_rows: (Ipopt, learned models) a refine round constrains the check points of
             those segments by coal's exact distance instead of the model's raised bound
             (:mod:`gdnplan.trajopt.refine`).
+        polish: (Ipopt) more solves from the cheapest certified path with tighter stops,
+            more check points and smaller buffers; each kept when certified and cheaper
+            (:func:`gdnplan.trajopt.polish.polish`).
+        repair: (Ipopt) when no seed's path was certified, one more solve from the last path
+            with more check points and a wider buffer (:func:`gdnplan.trajopt.polish.repair`).
     """
 
     ccd: bool = True
@@ -156,9 +161,11 @@ class RefineConfig:
     clearance_buffer: float = 0.002
     raise_window: int | None = 2
     exact_rows: bool = True
+    polish: bool = True
+    repair: bool = True
 
     def __post_init__(self) -> None:
-        _check_bools(self, ("ccd", "warm_start", "exact_rows"))
+        _check_bools(self, ("ccd", "warm_start", "exact_rows", "polish", "repair"))
         check_int(self.rounds, "rounds", 0, MAX_REFINE_ROUNDS)
         check_number(self.clearance_buffer, "clearance_buffer")
         if self.raise_window is not None:

@@ -25,6 +25,7 @@ from .config import AdamConfig, IpoptConfig, PlanConfig, finite_budget, with_opt
 from .ik import first_joint_barrier, tip_point, tip_position
 from .ipopt import _plan_ipopt
 from .options import TrajoptOptions
+from .polish import polish, repair
 from .problem import Problem
 from .result import Plan, _finish
 
@@ -114,6 +115,10 @@ def plan(
     deadline = t0 + finite_budget(cfg.seed.time_budget)
     if isinstance(cfg.optimizer, IpoptConfig):
         run = _plan_ipopt(problem, model, goal, cfg, seed, deadline)
+        if cfg.refine.repair:
+            repair(problem, model, goal, cfg, run, deadline)
+        if cfg.refine.polish:
+            polish(problem, model, goal, cfg, run, deadline)
     else:
         run = _plan_adam(problem, model, goal, cfg, seed, deadline)
     result = _finish(problem, run, t0)
