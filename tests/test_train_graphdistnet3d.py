@@ -44,6 +44,12 @@ def test_an_epoch_visits_every_row_once_and_resumes_in_place(split):
     assert other != [r for _, _, r in seen]
 
 
+def test_distance_only_training_takes_steps(split, tmp_path):
+    c = Train3DConfig(batch=25, validate_every=2, n_val=20, grad_weight=0.0)
+    state = train3d(split / "train", split / "val", tmp_path, c, time_budget=0, echo=lambda s: None)
+    assert state["step"] == 2 and np.isfinite(state["log"][-1]["mae_m"])
+
+
 @pytest.mark.slow
 def test_training_resumes_from_its_checkpoint(split, tmp_path):
     c = Train3DConfig(batch=25, validate_every=2, n_val=20, grad_weight=0.1)

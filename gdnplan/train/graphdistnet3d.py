@@ -40,6 +40,7 @@ from ..models.graphdistnet3d import (
     boxes_input,
     forward_with_grad,
     obstacle_input,
+    robot_tensors,
 )
 from ..models.weights import read_card, write_weights
 from .checkpoint import load_checkpoint, save_checkpoint
@@ -116,8 +117,15 @@ class Batch3D:
         self.grad = torch.as_tensor(shard["grad"][rows], dtype=torch.float32)
 
     def run(self, net: GraphDistNet3D, graph, create_graph: bool):
+        """d̂ (B,) and ∂d̂/∂q (B, dof); ``create_graph`` to train on the gradient."""
         feats = net.obstacle_pass(self.obstacles).take(self.scene_rows)
         return forward_with_grad(net, graph, self.nodes, self.jac, feats, create_graph)
+
+    def distance(self, net: GraphDistNet3D, graph) -> torch.Tensor:
+        """d̂ (B,) alone (training on the distance loss only: no double backward)."""
+        feats = net.obstacle_pass(self.obstacles).take(self.scene_rows)
+        nbr, nbr_mask = robot_tensors(graph)
+        return net(self.nodes, nbr, nbr_mask, feats)
 
 
 def evaluate3d(net: GraphDistNet3D, folder: Path | str, n: int | None = None, chunk: int = 200):
@@ -206,10 +214,12 @@ def train3d(
             files, config.batch, config.seed, state["epoch"], state["step"]
         ):
             b = Batch3D(graph, shard, rows)
-            d_hat, g_hat = b.run(net, graph, config.grad_weight > 0)
-            loss = distance_loss(d_hat, b.d, loss_cfg, network.scale)
             if config.grad_weight > 0:
+                d_hat, g_hat = b.run(net, graph, True)
+                loss = distance_loss(d_hat, b.d, loss_cfg, network.scale)
                 loss = loss + gradient_loss(g_hat, b.grad, loss_cfg, network.scale)
+            else:
+                loss = distance_loss(b.distance(net, graph), b.d, loss_cfg, network.scale)
             opt.zero_grad()
             loss.backward()
             opt.step()
@@ -299,11 +309,19 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--run-dir", type=Path, default=Path("runs/ur5e_boxes-3d"))
     p.add_argument("--time-budget", type=float, default=None, help="seconds of this invocation")
     p.add_argument("--export", type=Path, default=None, help="write the best weights + card here")
+    p.add_argument("--lr", type=float, default=Train3DConfig.lr, help="initial learning rate")
+    p.add_argument(
+        "--grad-weight",
+        type=float,
+        default=Train3DConfig.grad_weight,
+        help="λ of the gradient-cosine loss (0: distance loss only, no double backward)",
+    )
     a = p.parse_args(argv)
     if a.export is not None:
         print(json.dumps(export_weights(a.run_dir, a.export, a.val)["test"], indent=1))
         return
-    train3d(a.train, a.val, a.run_dir, time_budget=a.time_budget)
+    config = Train3DConfig(lr=a.lr, grad_weight=a.grad_weight)
+    train3d(a.train, a.val, a.run_dir, config, time_budget=a.time_budget)
 
 
 if __name__ == "__main__":

@@ -20,7 +20,10 @@ class GraphDistNet3DConfig:
         mlp: hidden widths of each h_k. readout: hidden widths of the final MLP.
         cross_k: soft partners among the k + 1 nearest obstacle nodes (the farthest at weight 0).
         tau: initial temperature τ of the partner weights (normalised units², learned per layer).
-        scale: metres per normalised unit (the arm's reach); d̂ = scale · net output.
+        length: metres per normalised coordinate unit, x = (p − origin) / length: the size of
+            the geometry the messages resolve (link radii, clearances), so that the relative
+            vectors of edges and cross edges are O(1) at initialisation.
+        scale: metres per unit of the net's output (the arm's reach); d̂ = scale · net output.
         origin: (x, y, z) subtracted from coordinates before scaling (the base, m).
         rim: points per cylinder rim of the robot graph (:func:`gdnplan.graph3d.robot_graph3d`).
     """
@@ -30,7 +33,8 @@ class GraphDistNet3DConfig:
     mlp: tuple[int, ...] = (32, 32, 32)
     readout: tuple[int, ...] = (32, 32, 32)
     cross_k: int = 4
-    tau: float = 0.02
+    tau: float = 2.0
+    length: float = 0.1
     scale: float = 1.0
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rim: int = 8
@@ -40,8 +44,10 @@ class GraphDistNet3DConfig:
             value = getattr(self, f.name)
             if any(isinstance(v, float) and not math.isfinite(v) for v in np.ravel(value)):
                 raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
-        if min(self.layers, self.hidden, self.cross_k) < 1 or self.scale <= 0 or self.tau <= 0:
+        if min(self.layers, self.hidden, self.cross_k) < 1 or min(self.scale, self.tau) <= 0:
             raise InputError("layers, hidden, cross_k, tau and scale must be positive")
+        if self.length <= 0:
+            raise InputError(f"length: expected a positive length (m), got {self.length}")
         if len(self.origin) != 3:
             raise InputError(f"origin: expected (x, y, z), got {self.origin!r}")
         if self.rim < 3:

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import torch
 from torch import nn
 
-from ..graphdistnet.layers import _activation, masked_softmax, mlp
+from ..graphdistnet.layers import LEAKY_SLOPE, _activation, masked_softmax, mlp
 from .config import GraphDistNet3DConfig
 
 PAD_DIST2 = 1e6  # squared distance (normalised units²) of padded obstacle nodes
@@ -91,10 +91,11 @@ class GraphDistNet3D(nn.Module):
         self.log_tau = nn.Parameter(torch.full((c.layers,), math.log(c.tau)))
         self.head = mlp([2 * c.hidden, *c.readout, 1])
         self.out_act = _activation()
+        init_weights(self)
 
     def normalise(self, p: torch.Tensor) -> torch.Tensor:
         origin = torch.as_tensor(self.config.origin, dtype=p.dtype, device=p.device)
-        return (p - origin) / self.config.scale
+        return (p - origin) / self.config.length
 
     # ------------------------------------------------------------------ messages
     def messages(
@@ -195,6 +196,23 @@ class GraphDistNet3D(nn.Module):
             pooled = y if pooled is None else torch.maximum(pooled, y)
         both = torch.cat([pooled, feats.pooled.expand(b, -1)], -1)
         return self.head(both).squeeze(-1) * self.config.scale
+
+
+def init_weights(net: GraphDistNet3D, degree: int = 3) -> None:
+    """Initialise ``net`` so that features keep their size through the layers: He weights for
+    LeakyReLU(0.2) and zero biases in every linear layer (PyTorch's default shrinks the
+    variance threefold per layer and its biases then swamp the input: d̂ hardly depends on q),
+    the last layer of each h_k divided by the degree + 1 terms a message sums, and the head's
+    last layer by 10 (d̂ starts near a constant, but a constant whose gradients reach every
+    layer)."""
+    for m in net.modules():
+        if isinstance(m, nn.Linear):
+            nn.init.kaiming_normal_(m.weight, a=LEAKY_SLOPE, nonlinearity="leaky_relu")
+            nn.init.zeros_(m.bias)
+    with torch.no_grad():
+        for conv in net.convs:
+            conv[-1].weight /= degree + 1
+        net.head[-1].weight /= 10
 
 
 def _gather_nodes(x: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
