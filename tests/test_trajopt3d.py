@@ -83,7 +83,11 @@ def test_adam_and_acceleration_limits_run_on_a_3d_scene():
     free = Problem(Scene3D(load_robot3d("ur5e"), []), START, goal=GOAL, waypoints=5, margin=0.02)
     timed = plan(free, collision="coal", max_acceleration=2.0)
     assert timed.success and timed.attempts == 0  # the straight line, certified
-    assert timed.trajectory.kind == "stop"  # the curve certificate is planar
+    curve = timed.trajectory
+    assert curve.kind == "smooth"  # the curve certificate works in 3-D (self-collision too)
+    assert curve.min_distance is not None and curve.min_distance > 0
+    _, q = curve.sample(curve.duration / 200)
+    assert signed_distance3d(free.scene, q).min() >= curve.min_distance - 1e-9
 
 
 def test_coal_is_the_3d_model_and_no_learned_3d_model_ships():
