@@ -162,37 +162,22 @@ def test_cli_view3d_without_meshcat_fails_before_planning(monkeypatch, capsys):
     assert "meshcat is not installed" in capsys.readouterr().err
 
 
-class Recorder:
-    """A meshcat window that keeps the packed commands instead of sending them."""
-
-    def __init__(self):
-        self.commands = []
-
-    def send(self, command):
-        import umsgpack
-
-        data = command.lower()
-        umsgpack.packb(data)  # what the zmq window sends: must serialise
-        self.commands.append(data)
-
-
-def test_send_plan_loads_robot_objects_and_animation(fetch):
+def test_send_plan_loads_robot_objects_and_animation(fetch, meshcat_window):
     meshcat = pytest.importorskip("meshcat")
-    window = Recorder()
     open_ = fetch["open"]
     path = np.array([open_.info["q_pregrasp"], open_.info["q_grasp"]])
-    n = send_plan(meshcat.Visualizer(window=window), [(open_, path)], per_segment=2)
+    n = send_plan(meshcat.Visualizer(window=meshcat_window), [(open_, path)], per_segment=2)
     assert n == 3
-    objects = {c["path"] for c in window.commands if c["type"] == "set_object"}
+    objects = {c["path"] for c in meshcat_window.commands if c["type"] == "set_object"}
     geometry = full_robot(open_.robot).geometry.geometryObjects
     assert {f"/meshcat/ur5e/visuals/{g.name}" for g in geometry} <= objects
     assert {f"/meshcat/scene/{o.name}" for o in scene_objects(open_)} <= objects
-    (animation,) = [c for c in window.commands if c["type"] == "set_animation"]
+    (animation,) = [c for c in meshcat_window.commands if c["type"] == "set_animation"]
     clips = {a["path"]: a["clip"] for a in animation["animations"]}
     assert len(clips) == len(geometry) + len(scene_objects(open_))
     keys = clips["/meshcat/scene/stick"]["tracks"][0]["keys"]
     assert [k["time"] for k in keys] == [0, 1, 2]
-    (camera,) = [c for c in window.commands if c["path"].endswith("rotated/<object>")]
+    (camera,) = [c for c in meshcat_window.commands if c["path"].endswith("rotated/<object>")]
     assert camera["path"] == "/Cameras/default/rotated/<object>"
     assert camera["value"][2] > 1.0  # y-up camera frame: in front of the x–z plane (world −y)
 

@@ -168,21 +168,7 @@ def test_gif_refuses_bad_stages(post, tmp_path):
     assert not (tmp_path / "x.gif").exists()
 
 
-class Recorder:
-    """A meshcat window that keeps the packed commands instead of sending them."""
-
-    def __init__(self):
-        self.commands = []
-
-    def send(self, command):
-        import umsgpack
-
-        data = command.lower()
-        umsgpack.packb(data)  # what the zmq window sends: must serialise
-        self.commands.append(data)
-
-
-def test_meshcat_scene_of_a_3d_plan(post):
+def test_meshcat_scene_of_a_3d_plan(post, meshcat_window):
     meshcat = pytest.importorskip("meshcat")
     path = np.array([START, UP, GOAL])
     names, poses = frames3d([(post, path)], per_segment=3)
@@ -191,11 +177,11 @@ def test_meshcat_scene_of_a_3d_plan(post):
     meshes = scene3d_meshes(post, np.array(START))
     assert [m.name for m in meshes[: len(names)]] == names
     assert len(meshes) == len(names) + len(post.obstacles)
-    window = Recorder()
-    assert send_plan3d(meshcat.Visualizer(window=window), [(post, path)], per_segment=3) == 7
-    objects = {c["path"] for c in window.commands if c["type"] == "set_object"}
+    viewer = meshcat.Visualizer(window=meshcat_window)
+    assert send_plan3d(viewer, [(post, path)], per_segment=3) == 7
+    objects = {c["path"] for c in meshcat_window.commands if c["type"] == "set_object"}
     assert {f"/meshcat/{m.name}" for m in meshes} == objects
-    (animation,) = [c for c in window.commands if c["type"] == "set_animation"]
+    (animation,) = [c for c in meshcat_window.commands if c["type"] == "set_animation"]
     assert {a["path"] for a in animation["animations"]} == {f"/meshcat/{n}" for n in names}
 
 
