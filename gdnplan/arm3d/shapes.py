@@ -59,8 +59,9 @@ def as_vector(value, n: int, name: str) -> np.ndarray:
 def as_size(value, name: str) -> float:
     """A primitive size (m) in [MIN_SIZE, MAX_COORDINATE], else InputError."""
     if not is_number(value) or not np.isfinite(value) or not MIN_SIZE <= value <= MAX_COORDINATE:
+        shown = value.item() if isinstance(value, np.generic) else value  # 0.0, not np.float64(0.0)
         raise InputError(
-            f"{name}: expected a size in [{MIN_SIZE:g}, {MAX_COORDINATE:g}] m, got {value!r}"
+            f"{name}: expected a size in [{MIN_SIZE:g}, {MAX_COORDINATE:g}] m, got {shown!r}"
         )
     return float(value)
 
