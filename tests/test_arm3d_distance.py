@@ -24,16 +24,6 @@ from gdnplan.errors import InputError
 from gdnplan.models import DistanceModel
 
 
-@pytest.fixture(scope="module")
-def panda_scene():
-    return random_boxes(load_robot3d("panda"), 20, seed=1)
-
-
-@pytest.fixture(scope="module")
-def ur5e_scene():
-    return random_boxes(load_robot3d("ur5e"), 20, seed=1)
-
-
 def qp_distance(a: np.ndarray, b: np.ndarray) -> float:
     """Distance of the convex hulls of point sets a (n, 3) and b (m, 3), independent of coal:
     the distance from the origin to the Minkowski difference hull{aᵢ − bⱼ} (Qhull), a QP in

@@ -8,17 +8,7 @@ import coal
 import numpy as np
 import pytest
 
-from gdnplan.arm3d import Checker3D, Scene3D, load_robot3d, obstacle, random_boxes
-
-
-@pytest.fixture(scope="module")
-def panda_scene():
-    return random_boxes(load_robot3d("panda"), 20, seed=1)
-
-
-@pytest.fixture(scope="module")
-def ur5e_scene():
-    return random_boxes(load_robot3d("ur5e"), 20, seed=1)
+from gdnplan.arm3d import Checker3D, Scene3D, load_robot3d, obstacle
 
 
 def fd_checks(checker: Checker3D, qs: np.ndarray, per_link: bool = False, h: float = 1e-5):
