@@ -76,7 +76,7 @@ def test_other_settings_are_refused(tmp_path, change, message):
     generate3d("ur5e_boxes", 50, out_dir=tmp_path, workers=1, **args)
     with pytest.raises(InputError, match=message):
         generate3d("ur5e_boxes", 50, out_dir=tmp_path, workers=1, **(args | change))
-    with pytest.raises(InputError, match="more samples"):
+    with pytest.raises(InputError, match="already holds 50 samples"):
         generate3d("ur5e_boxes", 10, out_dir=tmp_path, workers=1, **args)
 
 

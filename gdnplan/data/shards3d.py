@@ -15,27 +15,18 @@ no shared file system, and the shards are the same bytes as the local pool's.
 
 from __future__ import annotations
 
-import json
-import os
-from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from ..errors import InputError
-from ..files import atomic_path, write_text
+from ..files import atomic_path
 from .samples3d import ENVS3D, SCENE_SAMPLES, make_shard3d
-from .shards import MANIFEST, _shard_size
+from .shard_folder import check_manifest, check_split, missing_shards, run_jobs
+from .shard_folder import shard_plan as shard_plan  # re-exported
 
 SHARD_SIZE3D = 1000
-
-
-def shard_plan(out_dir: Path, n: int, size: int) -> list[tuple[int, int, Path]]:
-    """(start, samples, path) of every shard of an n-sample split."""
-    return [
-        (s, min(size, n - s), out_dir / f"shard_{s // size:04d}.npz") for s in range(0, n, size)
-    ]
 
 
 def save_shard(arrays: dict, path: Path | str) -> None:
@@ -55,35 +46,12 @@ def _write(job_path: tuple[tuple, str]) -> int:
     return job[3]
 
 
-def _check_manifest3d(out_dir: Path, settings: dict) -> None:
-    path = out_dir / MANIFEST
-    if not path.exists():
-        if any(out_dir.glob("shard_*.npz")):
-            raise InputError(f"data: {out_dir} holds shards but no {MANIFEST}; use another folder")
-        write_text(path, json.dumps(settings, indent=2) + "\n", "--data")
-        return
-    try:
-        recorded = json.loads(path.read_text())
-    except (ValueError, OSError) as e:
-        raise InputError(f"data: {path} is not a readable manifest ({e}); move the folder") from e
-    for key, value in settings.items():
-        if not isinstance(recorded, dict) or recorded.get(key) != value:
-            was = recorded.get(key) if isinstance(recorded, dict) else None
-            raise InputError(
-                f"--{key.replace('_', '-')}: {out_dir} holds a split made with {key} = {was!r}, "
-                f"not {value!r} ({MANIFEST}); use the same setting or another --data folder"
-            )
-
-
-def missing_shards3d(out_dir: Path, n: int, size: int) -> list[tuple[int, int, Path]]:
-    """The shards of an n-sample split still to make (InputError if the folder holds more)."""
-    plan = shard_plan(out_dir, n, size)
-    names = {p.name for _, _, p in plan}
-    shards = [p for p in out_dir.glob("shard_*.npz") if not p.name.endswith(".tmp.npz")]
-    sizes = {p: _shard_size(p) for _, _, p in plan if p.exists()}
-    if any(p.name not in names for p in shards) or any((sizes.get(p) or 0) > k for _, k, p in plan):
-        raise InputError(f"--n: {out_dir} holds more samples than n = {n}; ask for more")
-    return [(s, k, p) for s, k, p in plan if sizes.get(p) != k]
+MANIFEST_OPTIONS3D = {
+    "env": "--env",
+    "seed": "--seed",
+    "near": "--near",
+    "shard_size": "--shard-size",
+}
 
 
 def generate3d(
@@ -108,31 +76,21 @@ def generate3d(
     """
     if env not in ENVS3D:
         raise InputError(f"env: unknown 3-D environment {env!r}; choose one of {list(ENVS3D)}")
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise InputError(f"n: expected a positive number of samples, got {n!r}")
-    if not 0.0 <= near <= 1.0:
-        raise InputError(f"near: expected a fraction in [0, 1], got {near}")
+    check_split(n, near)
     if shard_size < 1 or shard_size % SCENE_SAMPLES:
         raise InputError(f"shard_size: expected a positive multiple of {SCENE_SAMPLES}")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     settings = {"env": env, "seed": int(seed), "near": float(near), "shard_size": shard_size}
-    _check_manifest3d(out_dir, settings)
-    todo = missing_shards3d(out_dir, n, shard_size)
+    check_manifest(out_dir, settings, MANIFEST_OPTIONS3D)
+    todo = missing_shards(out_dir, n, shard_size)
     jobs = [((env, int(seed), s, k, float(near)), str(p)) for s, k, p in todo]
     done = n - sum(j[0][3] for j in jobs)
     with tqdm(total=n, initial=done, desc=f"generate {env} → {out_dir}", unit="sample") as bar:
         if ray is not None:
             _run_ray(jobs, ray, bar)
-            return out_dir
-        workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
-        if workers < 2:
-            for job in jobs:
-                bar.update(_write(job))
         else:
-            with get_context("fork").Pool(workers) as pool:
-                for k in pool.imap_unordered(_write, jobs):
-                    bar.update(k)
+            run_jobs(_write, jobs, workers, bar)
     return out_dir
 
 

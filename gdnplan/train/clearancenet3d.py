@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..errors import InputError
 from ..models.clearancenet3d import ClearanceNet3D, ClearanceNet3DConfig, box_vector
 from .graphdistnet3d import read_shard, shard_files
 from .report import metrics
@@ -31,23 +32,35 @@ def load_arrays(folder: Path | str, n: int | None = None) -> dict[str, np.ndarra
 
 
 def train_clearancenet3d(
-    data: dict, scale: float, seconds: float, batch: int = 512, lr: float = 1e-3, seed: int = 0
+    data: dict,
+    scale: float,
+    seconds: float | None = None,
+    batch: int = 512,
+    lr: float = 1e-3,
+    seed: int = 0,
+    epochs: int | None = None,
 ) -> tuple[ClearanceNet3D, dict]:
-    """Train the baseline on ``data`` (:func:`load_arrays`) for ``seconds``; (net, summary)."""
+    """Train the baseline on ``data`` (:func:`load_arrays`) for ``seconds`` of wall time or
+    for exactly ``epochs`` epochs (reproducible whatever the machine's load; give one of the
+    two); (net, summary)."""
+    if (seconds is None) == (epochs is None):
+        raise InputError("train_clearancenet3d: give either seconds or epochs")
+    if epochs is not None and epochs < 1:
+        raise InputError(f"epochs: expected a positive number of epochs, got {epochs!r}")
     torch.manual_seed(seed)
     net = ClearanceNet3D(ClearanceNet3DConfig(dof=data["q"].shape[1], scale=scale))
     q, o, d = (torch.as_tensor(data[k], dtype=torch.float32) for k in ("q", "boxes", "d"))
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     gen = torch.Generator().manual_seed(seed)
-    start, epochs = time.perf_counter(), 0
-    while time.perf_counter() - start < seconds:
+    start, done = time.perf_counter(), 0
+    while done < epochs if epochs is not None else time.perf_counter() - start < seconds:
         for rows in torch.randperm(len(d), generator=gen).split(batch):
             loss = ((net(q[rows], o[rows]) - d[rows]) / scale).square().mean()
             opt.zero_grad()
             loss.backward()
             opt.step()
-        epochs += 1
-    return net.eval(), {"epochs": epochs, "seconds": time.perf_counter() - start, "n": len(d)}
+        done += 1
+    return net.eval(), {"epochs": done, "seconds": time.perf_counter() - start, "n": len(d)}
 
 
 def evaluate_clearancenet3d(net: ClearanceNet3D, data: dict) -> dict:
