@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from .builtin import load_robot3d, robot3d_names
 from .ccd3d import certify_path3d, lever_arms3d, motion_bound3d
+from .cloud3d import cloud_obstacle, read_cloud
 from .distance3d import (
     Checker3D,
     Coal3DModel,
@@ -54,6 +55,7 @@ __all__ = [
     "capsule_obstacle",
     "certify_path3d",
     "checker3d",
+    "cloud_obstacle",
     "convex_obstacle",
     "cylinder_obstacle",
     "frame_pose",
@@ -64,6 +66,7 @@ __all__ = [
     "motion_bound3d",
     "obstacle",
     "random_boxes",
+    "read_cloud",
     "robot3d_from_urdf",
     "robot3d_names",
     "signed_distance3d",

@@ -93,7 +93,7 @@ def _urdf(table: dict, base_dir: Path) -> Robot3D:
 def held_from_table(robot: Robot3D, table, base_dir: Path) -> Robot3D:
     """``robot`` holding the ``[robot.held]`` shape at its pose in the tool frame."""
     where = "[robot.held]"
-    part = posed_shape(table, where, base_dir, "held", frozenset({HELD_FRAME_KEY}))
+    part = posed_shape(table, where, base_dir, "held", frozenset({HELD_FRAME_KEY}), solid=True)
     frame = table.get(HELD_FRAME_KEY)
     if frame is not None and not isinstance(frame, str):
         raise ProblemFileError(f"{where} frame: expected a frame name, got {frame!r}")

@@ -14,7 +14,7 @@ Every number is validated before coal sees it. A TOML schema comes later; the Py
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import coal
 import numpy as np
@@ -29,12 +29,14 @@ MAX_OBSTACLES = 10_000
 
 @dataclass(frozen=True)
 class Obstacle3D:
-    """A convex obstacle: its coal shape and world placement.
+    """An obstacle: its coal shape and world placement.
 
     Attributes:
-        name: for messages and reports. shape: the coal shape in its own frame.
+        name: for messages and reports. shape: the coal shape in its own frame (convex, or an
+            octree of a point cloud, :mod:`gdnplan.arm3d.cloud3d`).
         pose: the shape frame's world placement (coal.Transform3s).
         center: (3,) world centre of its bounding sphere (m); radius: that sphere's radius (m).
+        points: (k, 3) a point cloud's points in the shape frame (m); None for other shapes.
     """
 
     name: str
@@ -42,6 +44,7 @@ class Obstacle3D:
     pose: coal.Transform3s
     center: np.ndarray
     radius: float
+    points: np.ndarray | None = field(default=None, repr=False)
 
 
 def obstacle(shape, position=(0.0, 0.0, 0.0), rotation=None, name: str = "obstacle"):

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import GdnplanError, ProblemFileError
 from ..scene import no_unknown_keys
+from .cloud3d import DEFAULT_RESOLUTION, cloud_obstacle, read_cloud
 from .scene3d import (
     Obstacle3D,
     box_obstacle,
@@ -36,7 +37,9 @@ OBSTACLE3D_KEYS = {  # type -> its own keys besides POSE_KEYS
     "capsule": frozenset({"radius", "length"}),
     "convex": frozenset({"points"}),
     "mesh": frozenset({"file", "scale"}),
+    "cloud": frozenset({"points", "file", "resolution"}),
 }
+OPTIONAL3D_KEYS = {"mesh": frozenset({"scale"}), "cloud": OBSTACLE3D_KEYS["cloud"]}
 
 
 def rpy_matrix(rpy) -> np.ndarray:
@@ -87,19 +90,19 @@ def rpy_matrix_checked(value, where: str) -> np.ndarray:
 
 
 def posed_shape(
-    table, where: str, base_dir: Path, default_name: str, extra=frozenset()
+    table, where: str, base_dir: Path, default_name: str, extra=frozenset(), solid: bool = False
 ) -> Obstacle3D:
     """The shape and pose a table gives, as an :class:`Obstacle3D` (its pose in whatever frame
-    the table's place in the file means); ``extra``: further keys the caller reads itself."""
+    the table's place in the file means); ``extra``: further keys the caller reads itself;
+    ``solid``: refuse a point cloud (a part of the robot must be a solid shape)."""
     if not isinstance(table, dict):
         raise ProblemFileError(f"{where}: expected a table with type = ...")
+    kinds = [k for k in OBSTACLE3D_KEYS if not (solid and k == "cloud")]
     kind = table.get("type")
-    if not isinstance(kind, str) or kind not in OBSTACLE3D_KEYS:
-        raise ProblemFileError(
-            f"{where} type: expected one of {list(OBSTACLE3D_KEYS)}, got {kind!r}"
-        )
+    if not isinstance(kind, str) or kind not in kinds:
+        raise ProblemFileError(f"{where} type: expected one of {kinds}, got {kind!r}")
     no_unknown_keys(table, POSE_KEYS | OBSTACLE3D_KEYS[kind] | extra, where)
-    missing = sorted(OBSTACLE3D_KEYS[kind] - {"scale"} - set(table))
+    missing = sorted(OBSTACLE3D_KEYS[kind] - OPTIONAL3D_KEYS.get(kind, frozenset()) - set(table))
     if missing:
         raise ProblemFileError(f"{where} {missing[0]}: missing for a {kind}")
     name = table.get("name", default_name)
@@ -117,12 +120,30 @@ def posed_shape(
             return make(table["radius"], table["length"], position, rotation, name)
         if kind == "convex":
             return convex_obstacle(table["points"], position, rotation, name)
+        if kind == "cloud":
+            return _cloud(table, where, base_dir, position, rotation, name)
         path = file_path(table["file"], base_dir, f"{where} file")
         return mesh_obstacle(path, position, rotation, table.get("scale", [1, 1, 1]), name)
     except ProblemFileError:
         raise
     except GdnplanError as e:
         raise ProblemFileError(f"{where} ({name}): {e}") from e
+
+
+def _cloud(table: dict, where: str, base_dir: Path, position, rotation, name) -> Obstacle3D:
+    """A ``type = "cloud"`` table: exactly one of ``points`` / ``file``, ``resolution`` (m)."""
+    given = [k for k in ("points", "file") if k in table]
+    if len(given) != 1:
+        raise ProblemFileError(
+            f"{where}: a cloud takes exactly one of points = [[x, y, z], ...] or file = "
+            f'"cloud.npy", got {" and ".join(given) or "neither"}'
+        )
+    if "file" in table:
+        points = read_cloud(file_path(table["file"], base_dir, f"{where} file"), name)
+    else:
+        points = table["points"]
+    resolution = table.get("resolution", DEFAULT_RESOLUTION)
+    return cloud_obstacle(points, resolution, position, rotation, name)
 
 
 def obstacle_from_table(table, k: int, base_dir: Path) -> Obstacle3D:
@@ -134,6 +155,7 @@ def obstacle_from_table(table, k: int, base_dir: Path) -> Obstacle3D:
 
 __all__ = [
     "OBSTACLE3D_KEYS",
+    "OPTIONAL3D_KEYS",
     "POSE_KEYS",
     "ROTATION_KEYS",
     "file_path",

@@ -27,11 +27,16 @@ from .scene3d import Obstacle3D, Scene3D
 BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
-def shape_table(shape, rotation: np.ndarray, position: np.ndarray, name: str) -> dict:
-    """The table of a posed coal shape (type, sizes, name, position, matrix; m).
+def shape_table(shape, rotation: np.ndarray, position: np.ndarray, name: str, points=None) -> dict:
+    """The table of a posed coal shape (type, sizes, name, position, matrix; m); ``points``:
+    a point cloud's points (k, 3) when ``shape`` is its octree.
 
-    InputError for a shape a problem file cannot name (an octree, a non-convex mesh)."""
-    if isinstance(shape, coal.Box):
+    InputError for a shape a problem file cannot name (an octree without its points, a
+    non-convex mesh)."""
+    if isinstance(shape, coal.OcTree) and points is not None:
+        pts = np.asarray(points, float).tolist()
+        sizes = {"type": "cloud", "points": pts, "resolution": float(shape.getResolution())}
+    elif isinstance(shape, coal.Box):
         sizes = {"type": "box", "size": (2 * np.asarray(shape.halfSide)).tolist()}
     elif isinstance(shape, coal.Sphere):
         sizes = {"type": "sphere", "radius": float(shape.radius)}
@@ -51,9 +56,8 @@ def shape_table(shape, rotation: np.ndarray, position: np.ndarray, name: str) ->
 def obstacle_table(obstacle: Obstacle3D) -> dict:
     """An obstacle's ``[[scene3d.obstacles]]`` table (world pose)."""
     pose = obstacle.pose
-    return shape_table(
-        obstacle.shape, np.asarray(pose.getRotation()), pose.getTranslation(), obstacle.name
-    )
+    rotation, position = np.asarray(pose.getRotation()), pose.getTranslation()
+    return shape_table(obstacle.shape, rotation, position, obstacle.name, obstacle.points)
 
 
 def held_table(robot: Robot3D) -> dict | None:

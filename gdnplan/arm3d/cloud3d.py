@@ -1,0 +1,128 @@
+"""Point-cloud obstacles: a sensor's points as a coal octree of occupied voxels.
+
+A cloud of k points p_i (m, in the obstacle's frame) becomes the union of the axis-aligned
+cubes of edge ``resolution`` r of a grid aligned with that frame that hold a point
+(``coal.makeOctree``). Every point lies in an occupied cube, so the octree is a superset of the
+points: a distance to it is a lower bound of the distance to the points, within r√3 of it, and
+a path certified against the octree is certified against the points (every certificate of
+gdnplan is against the octree). A cloud samples surfaces: choose r at least the spacing of
+neighbouring points, or the robot may pass between voxels where the real surface is closed.
+
+coal's octree holds coordinates |x| < r · 2¹⁵ only and silently drops points beyond them, so
+such clouds are refused (:data:`OCTREE_HALF_CELLS`), as are non-finite coordinates, more than
+:data:`MAX_CLOUD_POINTS` points and a resolution outside [:data:`MIN_RESOLUTION`,
+:data:`MAX_RESOLUTION`].
+
+Files (``[[scene3d.obstacles]] type = "cloud"``, ``docs/problem_file_3d.md``): a NumPy ``.npy``
+array (k, 3), or a text file of one point per line, ``x y z`` or ``x, y, z`` (``#`` comments).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import coal
+import numpy as np
+
+from ..errors import InputError, UnknownNameError
+from ..limits import is_number
+from .scene3d import Obstacle3D, obstacle
+from .shapes import MAX_COORDINATE
+
+MAX_CLOUD_POINTS = 2_000_000  # points of one cloud
+MIN_RESOLUTION = 1e-3  # m: smallest voxel edge
+MAX_RESOLUTION = 1.0  # m: largest voxel edge
+OCTREE_HALF_CELLS = 2**15  # coal's octree (depth 16) spans |x| < resolution · 2¹⁵
+DEFAULT_RESOLUTION = 0.02  # m
+
+
+def cloud_points(points, name: str) -> np.ndarray:
+    """A finite float (k, 3) point array, 1 ≤ k ≤ MAX_CLOUD_POINTS, |x| ≤ MAX_COORDINATE m;
+    else InputError."""
+    try:
+        pts = np.asarray(points, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"{name}: expected points of shape (k, 3), got {type(points)}") from e
+    if pts.ndim != 2 or pts.shape[1] != 3 or not 1 <= len(pts) <= MAX_CLOUD_POINTS:
+        raise InputError(
+            f"{name}: expected (k, 3) points with 1 ≤ k ≤ {MAX_CLOUD_POINTS}, got {pts.shape}"
+        )
+    if not np.all(np.isfinite(pts)):
+        raise InputError(f"{name}: contains NaN or infinite coordinates")
+    if np.max(np.abs(pts)) > MAX_COORDINATE:
+        raise InputError(f"{name}: coordinates beyond {MAX_COORDINATE:g} m; use metres")
+    return pts
+
+
+def cloud_resolution(value, name: str) -> float:
+    """A voxel edge (m) in [MIN_RESOLUTION, MAX_RESOLUTION], else InputError."""
+    if not is_number(value) or not MIN_RESOLUTION <= value <= MAX_RESOLUTION:
+        shown = value.item() if isinstance(value, np.generic) else value
+        raise InputError(
+            f"{name}: expected a voxel edge in [{MIN_RESOLUTION:g}, {MAX_RESOLUTION:g}] m, "
+            f"got {shown!r}"
+        )
+    return float(value)
+
+
+def octree(points, resolution: float = DEFAULT_RESOLUTION, name: str = "cloud") -> coal.OcTree:
+    """The coal octree of ``points`` (k, 3) at voxel edge ``resolution`` (m); see the module."""
+    pts = cloud_points(points, f"{name}.points")
+    r = cloud_resolution(resolution, f"{name}.resolution")
+    reach = float(np.max(np.abs(pts)))
+    if reach >= 0.999 * r * OCTREE_HALF_CELLS:
+        raise InputError(
+            f"{name}: a point {reach:.4g} m from the cloud's origin is beyond what an octree of "
+            f"{r:g} m voxels holds ({r * OCTREE_HALF_CELLS:.4g} m); give the points relative "
+            "to a position near them, or a coarser resolution"
+        )
+    return coal.makeOctree(np.ascontiguousarray(pts), r)
+
+
+def cloud_obstacle(
+    points,
+    resolution: float = DEFAULT_RESOLUTION,
+    position=(0.0, 0.0, 0.0),
+    rotation=None,
+    name: str = "cloud",
+) -> Obstacle3D:
+    """A point cloud (k, 3) in the obstacle's frame (m) as an octree obstacle of voxel edge
+    ``resolution`` (m), posed by ``position`` and ``rotation``; it keeps its points."""
+    pts = cloud_points(points, f"{name}.points")
+    return replace(obstacle(octree(pts, resolution, name), position, rotation, name), points=pts)
+
+
+def read_cloud(path: Path | str, name: str = "cloud") -> np.ndarray:
+    """The (k, 3) points of a ``.npy`` file or a text file of ``x y z`` / ``x, y, z`` lines (m);
+    UnknownNameError for a missing file, InputError for one that holds no such points."""
+    path = Path(path)
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):
+        found = False
+    if not found:
+        raise UnknownNameError(f"{name}: point file {path} does not exist (or is not a file)")
+    try:
+        if path.suffix.lower() == ".npy":
+            pts = np.load(path, allow_pickle=False)
+        else:
+            text = path.read_text(errors="strict").replace(",", " ")
+            pts = np.loadtxt(text.splitlines(), dtype=float, comments="#", ndmin=2)
+    except (OSError, ValueError, UnicodeDecodeError) as e:
+        first = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise InputError(f"{name}: {path.name} is not a point file ({first})") from e
+    return cloud_points(pts, f"{name} ({path.name})")
+
+
+__all__ = [
+    "DEFAULT_RESOLUTION",
+    "MAX_CLOUD_POINTS",
+    "MAX_RESOLUTION",
+    "MIN_RESOLUTION",
+    "cloud_obstacle",
+    "cloud_points",
+    "cloud_resolution",
+    "octree",
+    "read_cloud",
+]
