@@ -1,6 +1,6 @@
 """Plan around an obstacle known only as a point cloud (a depth sensor's scan).
 
-python examples/05_point_cloud.py [OUT_DIR]
+python examples/05_point_cloud.py [OUT_DIR]   (default: a new temporary folder)
 
 1. A synthetic scan: points on the robot-facing side and the top of a wall 0.5 m in front of a
    UR5e, with 2 mm of sensor noise, saved as a text file of ``x y z`` lines.
@@ -16,6 +16,7 @@ The shipped ``problems/ur5e_cloud3d.toml`` and its scan were written by this scr
 """
 
 import sys
+import tempfile
 from pathlib import Path
 
 import coal
@@ -102,4 +103,4 @@ def main(out_dir: Path) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("cloud_problem"))
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path(tempfile.mkdtemp(prefix="cloud_")))

@@ -12,7 +12,7 @@ import pytest
 import gdnplan as gp
 from gdnplan.assets import problem_names
 from gdnplan.cli import plan_summary
-from gdnplan.exact import certify
+from gdnplan.exact import certify, exact_distance
 from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
 from gdnplan.trajopt.check_points import constraint_margin
 from gdnplan.trajopt.result import _finish, _Run
@@ -111,7 +111,7 @@ def dense_min_distance(scene, q: np.ndarray, per_segment: int = 200) -> float:
     (the certificate's proven bound must lie below it)."""
     s = np.linspace(0.0, 1.0, per_segment + 1)[:, None]
     points = np.concatenate([a + s * (b - a) for a, b in itertools.pairwise(q)])
-    return float(np.min(gp.signed_distance(scene, points)))
+    return float(np.min(exact_distance(scene, points)))  # planar or 3-D
 
 
 def check_promise(problem: Problem, result) -> None:
