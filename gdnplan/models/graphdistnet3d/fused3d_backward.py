@@ -90,8 +90,7 @@ if AVAILABLE:
             m = st.mask[k, layer]
             for r in range(a.shape[0]):
                 for o in range(p):
-                    if not m[r, o]:
-                        a[r, o] *= slope
+                    a[r, o] = a[r, o] if m[r, o] else a[r, o] * slope
         duv = np.zeros((t_n * n, 2 * p), dh.dtype)  # [∂u, ∂v], ∂v = −∂c
         for t in range(t_n):
             base, off = t * per, t * n

@@ -21,12 +21,14 @@ from ..graphdistnet.fused import AVAILABLE
 
 class Weights(NamedTuple):
     """The network and one scene's constants as contiguous arrays of one dtype (M obstacle
-    nodes): xo (M, 3), tau (K,), score (K, M) (zeros at k = 0), v (K, M, P), ax (K, 3, 2P),
-    ah (K, H, 2P) (zeros at k = 0) and aht (K, 2P, H), b1 (K, P), wht / wh (K, L, P, P)
-    (transposed / not), bh (K, L, P), wlt (K, P, H) / wl (K, H, P), bl (K, H), att (K, H),
-    h0t (H, R) / h0 (R, H), hb0 (R,), hwt / hw (Lr, R, R), hb (Lr, R), wlast (R,), blast (1,)."""
+    nodes): xo (M, 3) and xot (3, M), tau (K,), score (K, M) (zeros at k = 0), v (K, M, P),
+    ax (K, 3, 2P), ah (K, H, 2P) (zeros at k = 0) and aht (K, 2P, H), b1 (K, P),
+    wht / wh (K, L, P, P) (transposed / not), bh (K, L, P), wlt (K, P, H) / wl (K, H, P),
+    bl (K, H), att (K, H), h0t (H, R) / h0 (R, H), hb0 (R,), hwt / hw (Lr, R, R), hb (Lr, R),
+    wlast (R,), blast (1,)."""
 
     xo: np.ndarray
+    xot: np.ndarray
     tau: np.ndarray
     score: np.ndarray
     v: np.ndarray
@@ -84,27 +86,34 @@ if AVAILABLE:
     from .fused3d_backward import _backward_tile
 
     @_jit
-    def _candidates(x, xo, cand, idx, near, lphi):
-        """idx, near (T, n, C): the C nearest obstacle nodes of every x (T, n, 3), ascending
-        d² (insertion sort); lphi = log max(d²_C − d², 1e-12)."""
+    def _candidates(x, xot, cand, idx, near, lphi):
+        """idx, near (T, n, C): the C nearest obstacle nodes (xot (3, M)) of every x (T, n, 3),
+        ascending d² (all d² of a node first, vectorised; then an insertion sort);
+        lphi = log max(d²_C − d², 1e-12)."""
         t_n, n, _ = x.shape
+        m = xot.shape[1]
+        dd = np.empty(m, x.dtype)
         for t in range(t_n):
             for i in range(n):
                 x0, x1, x2 = x[t, i, 0], x[t, i, 1], x[t, i, 2]
+                for j in range(m):
+                    dx, dy, dz = x0 - xot[0, j], x1 - xot[1, j], x2 - xot[2, j]
+                    dd[j] = dx * dx + dy * dy + dz * dz
                 for c in range(cand):
                     near[t, i, c] = np.inf
                     idx[t, i, c] = 0
-                for j in range(xo.shape[0]):
-                    dx, dy, dz = x0 - xo[j, 0], x1 - xo[j, 1], x2 - xo[j, 2]
-                    dd = dx * dx + dy * dy + dz * dz
-                    if dd < near[t, i, cand - 1]:
+                worst = near[t, i, cand - 1]
+                for j in range(m):
+                    d = dd[j]
+                    if d < worst:
                         c = cand - 1
-                        while c > 0 and near[t, i, c - 1] > dd:
+                        while c > 0 and near[t, i, c - 1] > d:
                             near[t, i, c] = near[t, i, c - 1]
                             idx[t, i, c] = idx[t, i, c - 1]
                             c -= 1
-                        near[t, i, c] = dd
+                        near[t, i, c] = d
                         idx[t, i, c] = j
+                        worst = near[t, i, cand - 1]
                 for c in range(cand):
                     lphi[t, i, c] = np.log(max(near[t, i, cand - 1] - near[t, i, c], 1e-12))
 
@@ -116,12 +125,12 @@ if AVAILABLE:
         n, cand = st.idx.shape[1], st.idx.shape[2]
         for t in range(t_n):
             for i in range(n):
-                top = -np.inf
+                top = st.lphi[t, i, 0] * 0 + st.lphi[t, i, 0]  # the tile's dtype
                 for c in range(cand):
                     lg = st.lphi[t, i, c] - st.near[t, i, c] / wts.tau[k]
                     lg += wts.score[k, st.idx[t, i, c]]
                     w[t, i, c] = lg
-                    top = max(top, lg)
+                    top = lg if c == 0 else max(top, lg)
                 total = w[t, i, 0] * 0
                 for c in range(cand):
                     e = np.exp(w[t, i, c] - top)
@@ -136,14 +145,15 @@ if AVAILABLE:
         t_n, n = pooled.shape[0], st.alpha.shape[2]
         h = hk.shape[1]
         zero = hk[0, 0] * 0
+        ys = np.empty(h, hk.dtype)
         for t in range(t_n):
-            top = -np.inf
+            top = zero
             for i in range(n):
                 s = zero
                 for o in range(h):
                     s += hk[t * n + i, o] * wts.att[k, o]
                 st.alpha[k, t, i] = s
-                top = max(top, s)
+                top = s if i == 0 else max(top, s)
             total = zero
             for i in range(n):
                 e = np.exp(st.alpha[k, t, i] - top)
@@ -151,10 +161,13 @@ if AVAILABLE:
                 total += e
             for i in range(n):
                 st.alpha[k, t, i] /= total
+            ys[:] = zero
+            for i in range(n):
+                alpha = st.alpha[k, t, i]
+                for o in range(h):
+                    ys[o] += alpha * hk[t * n + i, o]
             for o in range(h):
-                y = zero
-                for i in range(n):
-                    y += st.alpha[k, t, i] * hk[t * n + i, o]
+                y = ys[o]
                 st.ypos[k, t, o] = y > 0
                 y = y if y > 0 else y * slope
                 if k == 0 or y > pooled[t, o]:
@@ -171,7 +184,7 @@ if AVAILABLE:
         n_e = graph.src.shape[0]
         per = n_e + n  # edge rows per configuration
         rows, e_rows = t_n * n, t_n * per
-        _candidates(x, wts.xo, st.idx.shape[2], st.idx, st.near, st.lphi)
+        _candidates(x, wts.xot, st.idx.shape[2], st.idx, st.near, st.lphi)
         pooled = np.empty((t_n, h), x.dtype)
         empty = np.empty(0, x.dtype)
         nomask = np.empty((0, p), np.bool_)
@@ -193,10 +206,13 @@ if AVAILABLE:
                             + x[t, i, 2] * wts.ax[k, 2, o]
                         )
                     for o in range(p):
-                        acc = w[t, i, 0] * 0
-                        for c in range(w.shape[2]):
-                            acc += w[t, i, c] * wts.v[k, st.idx[t, i, c], o]
-                        cc[r, o] = acc - uv[r, p + o] + wts.b1[k, o]
+                        cc[r, o] = 0
+                    for c in range(w.shape[2]):
+                        wc, j = w[t, i, c], st.idx[t, i, c]
+                        for o in range(p):
+                            cc[r, o] += wc * wts.v[k, j, o]
+                    for o in range(p):
+                        cc[r, o] = cc[r, o] - uv[r, p + o] + wts.b1[k, o]
             a = np.empty((e_rows, p), x.dtype)  # pre = u_j − u_i + c_i; self: c_i
             for t in range(t_n):
                 base, off = t * per, t * n
