@@ -43,7 +43,9 @@ from . import fused3d_kernels as _kernels
 from .config import GraphDistNet3DConfig
 from .network import GraphDistNet3D, ObstacleFeatures
 
-__all__ = ["Packed", "pack", "refusal", "run"]
+__all__ = ["TILE_ROWS", "Packed", "pack", "refusal", "run"]
+
+TILE_ROWS = 2048  # edge rows per tile (E + N_r per configuration; docs/decisions.md#tiles-3d)
 
 # the config fields this pass implements; any other field must keep its default value
 IMPLEMENTED = {
@@ -176,7 +178,7 @@ def run(packed: Packed, nodes: np.ndarray, grad: bool) -> tuple[np.ndarray, np.n
     b, n, _ = x.shape
     d = np.empty(b, dtype)
     g = np.zeros((b, n, 3) if grad else (0, n, 3), dtype)
-    tile = max(1, planar_fused.TILE_ROWS // (len(packed.graph.src) + n))
+    tile = max(1, TILE_ROWS // (len(packed.graph.src) + n))
     with planar_fused._serial_blas():
         _kernels.network(
             x,

@@ -186,7 +186,6 @@ if AVAILABLE:
         rows, e_rows = t_n * n, t_n * per
         _candidates(x, wts.xot, st.idx.shape[2], st.idx, st.near, st.lphi)
         pooled = np.empty((t_n, h), x.dtype)
-        empty = np.empty(0, x.dtype)
         nomask = np.empty((0, p), np.bool_)
         for k in range(layers):
             _soft_weights(k, t_n, wts, st)
@@ -213,17 +212,23 @@ if AVAILABLE:
                             cc[r, o] += wc * wts.v[k, j, o]
                     for o in range(p):
                         cc[r, o] = cc[r, o] - uv[r, p + o] + wts.b1[k, o]
-            a = np.empty((e_rows, p), x.dtype)  # pre = u_j − u_i + c_i; self: c_i
+            a = np.empty((e_rows, p), x.dtype)  # σ(pre), pre = u_j − u_i + c_i; self: c_i
+            m0 = st.mask[k, 0]
             for t in range(t_n):
                 base, off = t * per, t * n
                 for e in range(n_e):
                     i, j = off + graph.src[e], off + graph.dst[e]
                     for o in range(p):
-                        a[base + e, o] = (uv[j, o] - uv[i, o]) + cc[i, o]
+                        s = (uv[j, o] - uv[i, o]) + cc[i, o]
+                        a[base + e, o] = s if s > 0 else s * slope
+                        if keep:
+                            m0[base + e, o] = s > 0
                 for i in range(n):
                     for o in range(p):
-                        a[base + n_e + i, o] = cc[off + i, o]
-            _leaky_rows(a, empty, st.mask[k, 0, :e_rows] if keep else nomask, slope)
+                        s = cc[off + i, o]
+                        a[base + n_e + i, o] = s if s > 0 else s * slope
+                        if keep:
+                            m0[base + n_e + i, o] = s > 0
             for layer in range(wts.wht.shape[1]):
                 a = np.dot(a, wts.wht[k, layer])
                 m = st.mask[k, layer + 1, :e_rows] if keep else nomask
