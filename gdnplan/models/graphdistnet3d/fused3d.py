@@ -45,7 +45,7 @@ from .network import GraphDistNet3D, ObstacleFeatures
 
 __all__ = ["TILE_ROWS", "Packed", "pack", "refusal", "run"]
 
-TILE_ROWS = 2048  # edge rows per tile (E + N_r per configuration; docs/decisions.md#tiles-3d)
+TILE_ROWS = 2048  # edge rows per tile, E + N_r per configuration (docs/decisions.md, s6-fused3d)
 
 # the config fields this pass implements; any other field must keep its default value
 IMPLEMENTED = {
