@@ -8,10 +8,9 @@ float64) → d̂ of the robot–obstacle distance (``dtype``, chunks of ``chunk`
 (one-way cross edges) and cached. ``fused`` (default None: wherever it serves) runs the robot
 pass — d̂ and ∂d̂/∂p in one call per batch, no chunks — as the compiled numba pass of
 :mod:`.fused3d` instead of torch (False: torch; True: InputError where it cannot serve).
-Self-collision stays exact (``self_collision=True``): the
-reported distance is min(d̂, d_self) with d_self coal's signed distance over the robot's enabled
-self pairs (:class:`~gdnplan.arm3d.Checker3D` of the robot alone), and the gradient is the
-minimiser's.
+Self-collision stays exact (``self_collision=True``): the reported distance is min(d̂, d_self)
+with d_self coal's signed distance over the robot's enabled self pairs
+(:class:`~gdnplan.arm3d.Checker3D` of the robot alone), and the gradient is the minimiser's.
 """
 
 from __future__ import annotations
