@@ -9,7 +9,8 @@ out (a detour). Exact rows replace, at the check points of the rejected segments
 ``raise_window`` segments either side), the row d̂(p_k) ≥ b_k by d_coal(p_k) ≥ b_k: the bound
 needs no raise there and is the true distance wherever the path moves; the other check points
 keep the learned model. Coal's gradient is its closest-pair witness gradient
-(:func:`gdnplan.distance.signed_distance_and_grad`).
+(:func:`gdnplan.distance.signed_distance_and_grad`; in 3-D
+:func:`gdnplan.arm3d.signed_distance3d_and_grad`).
 """
 
 from __future__ import annotations
@@ -18,10 +19,24 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..arm3d.distance3d import signed_distance3d, signed_distance3d_and_grad
+from ..arm3d.scene3d import Scene3D
 from ..distance import signed_distance, signed_distance_and_grad
 from ..models import DistanceModel
 from ..scene import Scene
 from .check_points import _check_point_raise
+
+
+def _exact(scene: Scene | Scene3D, q: np.ndarray) -> np.ndarray:
+    """Coal's signed distance of the scene's kind (planar or 3-D)."""
+    return signed_distance3d(scene, q) if isinstance(scene, Scene3D) else signed_distance(scene, q)
+
+
+def _exact_and_grad(scene: Scene | Scene3D, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Coal's signed distance and witness gradient of the scene's kind."""
+    if isinstance(scene, Scene3D):
+        return signed_distance3d_and_grad(scene, q)
+    return signed_distance_and_grad(scene, q)
 
 
 def exact_check_points(splits: np.ndarray, exact: np.ndarray) -> np.ndarray:
@@ -56,7 +71,7 @@ class ExactRows:
         if (~m).any():
             d[~m] = self.model.distance(scene, q[~m])
         if m.any():
-            d[m] = signed_distance(scene, q[m])
+            d[m] = _exact(scene, q[m])
         return d
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -66,7 +81,7 @@ class ExactRows:
         if (~m).any():
             d[~m], g[~m] = self.model.distance_and_grad(scene, q[~m])
         if m.any():
-            d[m], g[m] = signed_distance_and_grad(scene, q[m])
+            d[m], g[m] = _exact_and_grad(scene, q[m])
         return d, g
 
     def _deferred(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
@@ -77,7 +92,7 @@ class ExactRows:
         if (~m).any():
             d[~m], learned = self.model.distance_deferred_grad(scene, q[~m])
         if m.any():
-            d[m], g_exact = signed_distance_and_grad(scene, q[m])
+            d[m], g_exact = _exact_and_grad(scene, q[m])
 
         def grad() -> np.ndarray:
             g = np.empty(q.shape)

@@ -13,11 +13,14 @@ from .model import GraphDistNet3DModel
 from .network import GraphDistNet3D
 
 
-def load_graphdistnet3d(path: Path | str, threads: int | None = None) -> GraphDistNet3DModel:
-    """The DistanceModel of a weights file (InputError for a card of another model)."""
+def load_graphdistnet3d(
+    path: Path | str, threads: int | None = None, fused: bool | None = None
+) -> GraphDistNet3DModel:
+    """The DistanceModel of a weights file (InputError for a card of another model); ``fused``
+    as in :class:`GraphDistNet3DModel`."""
     tensors, card = read_weights(path)
     if card.get("model") != "graphdistnet3d":
         raise InputError(f"weights: {path} holds a {card.get('model')!r} model, not graphdistnet3d")
     net = GraphDistNet3D(GraphDistNet3DConfig.from_dict(card["config"]))
     net.load_state_dict(tensors)
-    return GraphDistNet3DModel(net, card, threads=threads)
+    return GraphDistNet3DModel(net, card, threads=threads, fused=fused)

@@ -5,10 +5,12 @@ q → node positions and WORLD joint Jacobian columns (:meth:`RobotGraph3D.kinem
 float64) → d̂ of the robot–obstacle distance (``dtype``, chunks of ``chunk`` configurations) →
 ∂d̂/∂p_n by autograd on the node coordinates → ∂d̂/∂q = Σ_n (∂p_n/∂q)ᵀ ∂d̂/∂p_n
 (:meth:`RobotGraph3D.pullback`). The obstacle features are computed once per scene object
-(one-way cross edges) and cached. Self-collision stays exact (``self_collision=True``): the
-reported distance is min(d̂, d_self) with d_self coal's signed distance over the robot's enabled
-self pairs (:class:`~gdnplan.arm3d.Checker3D` of the robot alone), and the gradient is the
-minimiser's.
+(one-way cross edges) and cached. ``fused`` (default None: wherever it serves) runs the robot
+pass — d̂ and ∂d̂/∂p in one call per batch, no chunks — as the compiled numba pass of
+:mod:`.fused3d` instead of torch (False: torch; True: InputError where it cannot serve).
+Self-collision stays exact (``self_collision=True``): the reported distance is min(d̂, d_self)
+with d_self coal's signed distance over the robot's enabled self pairs
+(:class:`~gdnplan.arm3d.Checker3D` of the robot alone), and the gradient is the minimiser's.
 """
 
 from __future__ import annotations
@@ -29,9 +31,11 @@ from ...graph3d import (
     scene_graph3d,
 )
 from ..threads import check_threads, torch_threads
+from . import fused3d
 from .network import GraphDistNet3D, ObstacleFeatures, ObstacleInput
 
-CHUNK = 256  # configurations per inference pass
+CHUNK = 256  # configurations per inference pass of the torch path
+_NUMPY = {torch.float32: np.float32, torch.float64: np.float64}
 
 
 def obstacle_input(
@@ -103,6 +107,7 @@ class _SceneCache:
     nbr_mask: torch.Tensor
     feats: ObstacleFeatures
     self_checker: Checker3D | None
+    packed: fused3d.Packed | None  # the compiled pass's arrays (None: torch)
 
 
 class GraphDistNet3DModel:
@@ -118,6 +123,7 @@ class GraphDistNet3DModel:
         chunk: int = CHUNK,
         dtype: torch.dtype = torch.float32,
         threads: int | None = None,
+        fused: bool | None = None,
     ):
         self.net = net.to(dtype=dtype).eval()
         self.config = net.config
@@ -126,7 +132,17 @@ class GraphDistNet3DModel:
         self.chunk = chunk
         self.dtype = dtype
         self.threads = check_threads(threads)
+        self.fused = self._check_fused(fused)
         self._scenes: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    def _check_fused(self, fused: bool | None) -> bool:
+        """The ``fused`` setting resolved (module docstring); InputError when True cannot be."""
+        why = fused3d.refusal(self.config)
+        if why is None and self.dtype not in _NUMPY:
+            why = f"dtype {self.dtype}: the pass runs float32 or float64"
+        if fused and why is not None:
+            raise InputError(f"fused: the compiled GraphDistNet-3D pass cannot serve ({why})")
+        return why is None if fused is None else fused
 
     def check_scene(self, scene: Scene3D) -> None:
         """InputError unless ``scene`` is a Scene3D of the robot the weights were trained for."""
@@ -152,7 +168,11 @@ class GraphDistNet3DModel:
             if self.self_collision and len(scene.robot.self_pairs):
                 checker = Checker3D(Scene3D(scene.robot, ()))
             nbr, mask = robot_tensors(graph)
-            cached = self._scenes[scene] = _SceneCache(graph, nbr, mask, feats, checker)
+            packed = None
+            if self.fused:
+                packed = fused3d.pack(self.net, feats, graph, _NUMPY[self.dtype])
+            cached = _SceneCache(graph, nbr, mask, feats, checker, packed)
+            self._scenes[scene] = cached
         return cached
 
     def _chunks(self, n: int) -> list[slice]:
@@ -163,6 +183,9 @@ class GraphDistNet3DModel:
         q = scene.robot.check_q(q)
         with torch_threads(self.threads):
             c = self._cache(scene)
+            if c.packed is not None:
+                d, _ = fused3d.run(c.packed, c.graph.positions(q), grad=False)
+                return d.astype(np.float64)
             with torch.inference_mode():
                 out = [
                     self.net(self._tensor(c.graph.positions(q[s])), c.nbr, c.nbr_mask, c.feats)
@@ -176,6 +199,10 @@ class GraphDistNet3DModel:
         ds, gs = [], []
         with torch_threads(self.threads):
             c = self._cache(scene)
+            if c.packed is not None:
+                nodes, jac = c.graph.kinematics(q)
+                d, dx = fused3d.run(c.packed, nodes, grad=True)
+                return d.astype(np.float64), c.graph.pullback(nodes, jac, dx.astype(np.float64))
             for s in self._chunks(len(q)):
                 nodes, jac = c.graph.kinematics(q[s])
                 x = self._tensor(nodes).requires_grad_(True)
