@@ -46,6 +46,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.robot3d",
             "arm3d.builtin",
             "arm3d.scene3d",
+            "arm3d.cloud3d",  # point clouds as coal octrees (validated), no distances
             "arm3d.storage3d",  # the 3-D fetch storage: boxes and tool poses, no distances
             "arm3d.fk3d",  # batched forward kinematics in numpy
         ),
