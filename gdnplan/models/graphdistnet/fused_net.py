@@ -37,34 +37,31 @@ from . import fused_net_kernels as _kernels
 from .config import GraphDistNetConfig
 from .layers import LEAKY_SLOPE
 
-__all__ = ["OneWayWeights", "pack", "run", "serves"]
+__all__ = ["PackedNetwork", "pack", "run", "serves"]
 
 
 def serves(config: GraphDistNetConfig) -> bool:
-    """Whether the whole-network kernel computes this network: soft-kNN, one-way, no node
-    distances, edge MLP hidden widths all equal (:func:`.fused.supports`) and readout widths
-    all equal (at least one hidden layer in the head)."""
+    """Whether the whole-network kernel computes this network: soft-kNN, one-way or two-way,
+    no node distances (nor the soft-minimum readout that needs them), edge MLP hidden widths
+    all equal (:func:`.fused.supports`) and readout widths all equal (at least one hidden
+    layer in the head)."""
     return (
         fused.supports(config.mlp)
         and config.cross == "soft_knn"
-        and not config.two_way
         and not config.node_distance
+        and not config.min_readout
         and len(config.readout) >= 1
         and len(set(config.readout)) == 1
     )
 
 
 @dataclass(frozen=True)
-class OneWayWeights:
-    """The network and one scene's constants as contiguous arrays of the model's dtype
-    (K layers, H = d_h, L hidden layers of the edge MLP, R readout width, M obstacle nodes):
-    ``net`` holds, in the kernel's argument order, xo (M, 2), ring (2, N_r), tau (K,), score
-    (K, M), v (K, M, H), ax (K, 2, 2H), ah (K, H, 2H), aht (K, 2H, H), b1 (K, H), wht / wh
-    (K, L, H, H) (transposed / not), bh (K, L, H), wlt / wl (K, H, H), bl3 (K, H) = 3 b_L,
-    att (K, H), h0t (H, R), h0 (R, H), hb0 (R,), hwt / hw (Lr, R, R), hb (Lr, R), wlast (R,),
-    blast (1,); ``origin`` (2,), ``scale``, C = ``candidates``."""
+class PackedNetwork:
+    """The network and one scene's constants for the kernel: ``net`` a
+    :class:`~.fused_net_kernels.Net` of contiguous arrays of the model's dtype, ``origin``
+    (2,) and ``scale`` of the normalisation, C = ``candidates`` per node."""
 
-    net: tuple[np.ndarray, ...]
+    net: _kernels.Net
     origin: np.ndarray
     scale: float
     candidates: int
@@ -75,9 +72,9 @@ def _np(t: torch.Tensor, dtype: np.dtype) -> np.ndarray:
 
 
 @torch.no_grad()
-def pack(net, scene, dtype: np.dtype) -> OneWayWeights:
-    """:class:`OneWayWeights` of a :class:`~.network.GraphDistNet` ``net`` (:func:`serves`)
-    and its :class:`~.lean.SceneGraph` ``scene`` (with ``fixed``)."""
+def pack(net, scene, dtype: np.dtype) -> PackedNetwork:
+    """:class:`PackedNetwork` of a :class:`~.network.GraphDistNet` ``net`` (:func:`serves`)
+    and its :class:`~.lean.SceneGraph` ``scene`` (one-way: with ``fixed``)."""
     c, fixed = net.config, scene.fixed
     h = c.hidden
     ax, ah, b1, wh, bh, wl, bl = [], [], [], [], [], [], []
@@ -95,55 +92,60 @@ def pack(net, scene, dtype: np.dtype) -> OneWayWeights:
         wl.append(rest[-1].weight)
         bl.append(3 * rest[-1].bias.double())
     head = [m for m in net.head if isinstance(m, torch.nn.Linear)]
-    w0 = head[0].weight.double()
-    obstacle_half = fixed.readout.double().amax(0)  # max_k y_o⁽ᵏ⁾, a constant of the scene
-    hb0 = head[0].bias.double() + w0[:, h:] @ obstacle_half
+    w0, hb0 = head[0].weight.double(), head[0].bias.double()
+    n_r, n_o = len(scene.robot_ring) // 2, len(scene.obstacles)
+    if fixed is None:  # two-way: both graphs' readouts per configuration, partners per row
+        score, v, ring = w0.new_zeros(c.layers, 0), w0.new_zeros(c.layers, 0, h), scene.ring
+        cand = min(c.cross_k + 1, max(n_r, n_o))
+    else:  # one-way: max_k y_o⁽ᵏ⁾ is a constant of the scene, folded into the head's bias
+        hb0 = hb0 + w0[:, h:] @ fixed.readout.double().amax(0)
+        w0, score, v, ring = w0[:, :h], fixed.score, fixed.v, scene.robot_ring
+        cand = min(c.cross_k + 1, n_o)
     hw = torch.stack([m.weight for m in head[1:-1]]) if len(head) > 2 else w0.new_zeros(0, 1, 1)
     hb = torch.stack([m.bias for m in head[1:-1]]) if len(head) > 2 else w0.new_zeros(0, 1)
     whs, wls, ahs = torch.stack(wh), torch.stack(wl), torch.stack(ah)
-    n_r = len(scene.robot_ring) // 2
-    arrays = [
-        net.log_tau.exp(),
-        fixed.score,
-        fixed.v,
-        torch.stack(ax),
-        ahs,
-        ahs.transpose(1, 2),
-        torch.stack(b1),
-        whs.transpose(2, 3),
-        whs,
-        torch.stack(bh),
-        wls.transpose(1, 2),
-        wls,
-        torch.stack(bl),
-        net.attention,
-        w0[:, :h].T,
-        w0[:, :h],
-        hb0,
-        hw.transpose(1, 2),
-        hw,
-        hb,
-        head[-1].weight[0],
-        head[-1].bias,
-    ]
-    ring = np.ascontiguousarray(scene.robot_ring.view(2, n_r).cpu().numpy().astype(np.int64))
-    packed = [_np(scene.obstacles, dtype), ring, *(_np(t, dtype) for t in arrays)]
-    cand = min(c.cross_k + 1, len(scene.obstacles))
-    return OneWayWeights(tuple(packed), np.asarray(c.origin, dtype), float(c.scale), cand)
+    ring = np.ascontiguousarray(ring.view(2, -1).cpu().numpy().astype(np.int64))
+    arrays = _kernels.Net(
+        xo=_np(scene.obstacles, dtype),
+        ring=ring,
+        tau=net.log_tau.exp(),
+        score=score,
+        v=v,
+        ax=torch.stack(ax),
+        ah=ahs,
+        aht=ahs.transpose(1, 2),
+        b1=torch.stack(b1),
+        wht=whs.transpose(2, 3),
+        wh=whs,
+        bh=torch.stack(bh),
+        wlt=wls.transpose(1, 2),
+        wl=wls,
+        bl3=torch.stack(bl),
+        att=net.attention,
+        h0t=w0.T,
+        h0=w0,
+        hb0=hb0,
+        hwt=hw.transpose(1, 2),
+        hw=hw,
+        hb=hb,
+        wlast=head[-1].weight[0],
+        blast=head[-1].bias,
+        scale=np.dtype(dtype).type(c.scale),
+        slope=np.dtype(dtype).type(LEAKY_SLOPE),
+    )
+    tensors = {k: _np(t, dtype) for k, t in arrays._asdict().items() if isinstance(t, torch.Tensor)}
+    return PackedNetwork(arrays._replace(**tensors), np.asarray(c.origin, dtype), c.scale, cand)
 
 
-def run(weights: OneWayWeights, nodes: np.ndarray, grad: bool) -> tuple[np.ndarray, np.ndarray]:
+def run(weights: PackedNetwork, nodes: np.ndarray, grad: bool) -> tuple[np.ndarray, np.ndarray]:
     """d̂ (B,) (m) and, with ``grad``, ∂d̂/∂nodes (B, N_r, 2) (else an empty array) of robot
     nodes (B, N_r, 2) (m, converted to the weights' dtype)."""
     dtype = weights.origin.dtype
     x = np.ascontiguousarray((nodes - weights.origin) / dtype.type(weights.scale), dtype)
-    b, n, _ = x.shape
+    b, n_r, _ = x.shape
     d = np.empty(b, dtype)
-    g = np.zeros((b, n, 2) if grad else (0, n, 2), dtype)
-    tile = max(1, fused.TILE_ROWS // (3 * n))
-    scale = dtype.type(weights.scale)
+    g = np.zeros((b, n_r, 2) if grad else (0, n_r, 2), dtype)
+    tile = max(1, fused.TILE_ROWS // (3 * weights.net.ring.shape[1]))
     with fused._serial_blas():
-        _kernels.network(
-            x, *weights.net, weights.candidates, d, g, scale, dtype.type(LEAKY_SLOPE), tile
-        )
-    return d, g / scale
+        _kernels.network(x, weights.net, weights.candidates, d, g, tile)
+    return d, g / dtype.type(weights.scale)

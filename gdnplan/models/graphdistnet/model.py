@@ -232,7 +232,7 @@ class _SceneCache:
     robot: RobotGraph
     obstacles: GraphBatch
     lean: SceneGraph | None
-    whole: fused_net.OneWayWeights | None = None
+    whole: fused_net.PackedNetwork | None = None
 
 
 _NUMPY = {torch.float32: np.float32, torch.float64: np.float64}
