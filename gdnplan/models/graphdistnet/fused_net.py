@@ -1,28 +1,34 @@
-"""The whole one-way GraphDistNet as one numba pass: d̂ and ∂d̂/∂nodes, tile by tile in cache.
+"""The whole GraphDistNet as one numba pass: d̂ and ∂d̂/∂nodes, tile by tile in cache.
 
-For ``two_way=False`` networks without node distances (:func:`serves`) the work per
-configuration is the robot graph's alone (package docstring, "One-way"). This module runs all
-of it in one compiled call per batch: normalisation x = (p − origin) / scale, the C nearest
-obstacle nodes, and per layer k the soft weights, the first linear layer per node, the sparse
-cross mix, the edge MLP, the last linear layer, the attention readout and the running maximum,
-then the head; with the gradient, the hand-written backward of every step to the node
+For soft-kNN networks without node distances (:func:`serves`) this module runs the network in
+one compiled call per batch: normalisation x = (p − origin) / scale, the C nearest partner
+nodes, and per layer k the soft weights, the first linear layer per node, the sparse cross
+mix, the edge MLP, the last linear layer, the attention readout and the running maximum, then
+the head; with the gradient, the hand-written backward of every step to the robot node
 positions p (B, N_r, 2), tile by tile right after the tile's forward (its activations still in
-cache). Per robot node i, candidate c (obstacle node j_c, d²_ic = |x_i − x_o,j_c|²):
+cache). A configuration's rows are its N_r robot nodes (one-way, ``two_way=False``: package
+docstring, "One-way") or the union of its robot and N_o obstacle nodes (two-way: the obstacle
+graph's features depend on the configuration through its cross edges). Per row i, candidate c
+(node j_c of the other graph, d²_ic = |x_i − x_j_c|²):
 
     φ_ic = max(d²_iC − d²_ic, 1e-12),  ℓ_ic = log φ_ic − d²_ic / τ_k + s_k,j_c,  w = softmax_c ℓ,
     [u_i v_i] = z_i A_k,  c_i = Σ_c w_ic V_k,j_c − v_i + b_k,  pre = (u_j − u_i + c_i, c_i),
-    h_i = W_L Σ_e g(pre_e) + 3 b_L,  y_r = σ(Σ_i α_i h_i),  α = softmax_i(a_kᵀ h_i),
+    h_i = W_L Σ_e g(pre_e) + 3 b_L,  y_g = σ(Σ_{i∈g} α_i h_i),  α = softmax_{i∈g}(a_kᵀ h_i),
 
 z_i = x_i (k = 0) or (x_i ‖ h_i⁽ᵏ⁻¹⁾), g the hidden layers with σ = LeakyReLU(0.2) (the ring
-messages of :mod:`.fused`), V_k, s_k and the obstacle readout y_o⁽ᵏ⁾ the scene's constants
-(:class:`~.lean.ObstacleFeatures`); y_r = max_k y_r⁽ᵏ⁾, d̂ = scale · MLP(y_r ‖ max_k y_o⁽ᵏ⁾),
-whose first layer takes the constant obstacle half into its bias. Backward, reversed: the
-head, the maximum (to the layer that attained it), the readout softmax, the edge MLP (signs
-of the pre-activations kept as bytes), ∂u, ∂c → ∂z = [∂u, −∂c] A_kᵀ, the cross weights
-(∂w_ic = ∂c_i · V_k,j_c, then the softmax), ∂ℓ → ∂d²_ic (through −d²/τ_k and log φ,
-whose clamp passes no gradient) → ∂x_i += 2 (x_i − x_o,j_c) ∂d²_ic, and ∂p = ∂x / scale.
-Products are BLAS calls on the tile (:func:`numpy.dot` in numba), the rest loops.
-The torch reference computes the same function (tests/test_graphdistnet_fused_net.py).
+messages of :mod:`.fused`). Two-way: V_k,j = v_j and s_k,j = a_{k−1}ᵀ h_j⁽ᵏ⁻¹⁾ (0 at k = 0) are
+the partner row's own, d̂ = scale · MLP(max_k y_r ‖ max_k y_o). One-way: V_k, s_k and the
+obstacle readout y_o⁽ᵏ⁾ are the scene's constants (:class:`~.lean.ObstacleFeatures`) and the
+head's first layer takes the constant obstacle half into its bias. When the other graph has
+fewer than C nodes the missing candidates get weight 0. Backward, reversed: the head, the
+maximum (to the layer that attained it), the readout softmax, the edge MLP (signs of the
+pre-activations kept as bytes), ∂u, ∂c → ∂z = [∂u, −∂c] A_kᵀ, the cross weights (∂w_ic =
+∂c_i · V_k,j_c, then the softmax; two-way also ∂v_j_c += w_ic ∂c_i and ∂h_j_c⁽ᵏ⁻¹⁾ += ∂ℓ_ic
+a_{k−1}), ∂ℓ → ∂d²_ic (through −d²/τ_k and log φ, whose clamp passes no gradient) → the
+robot node of the pair += 2 (x_robot − x_obstacle) ∂d²_ic, and ∂p = ∂x / scale (obstacle
+nodes are constants). Products are BLAS calls on the tile (:func:`numpy.dot` in numba), the
+rest loops. The torch reference computes the same function
+(tests/test_graphdistnet_fused_net.py).
 """
 
 from __future__ import annotations
