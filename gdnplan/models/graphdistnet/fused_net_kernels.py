@@ -137,11 +137,15 @@ if AVAILABLE:
             for i in range(n):
                 r = t * n + i
                 for o in range(h):
-                    acc = net.scale * 0
-                    for c in range(cand):
-                        j = st.idx[t, i, c]
-                        acc += w[t, i, c] * (st.v[k, t * n + j, o] if two_way else net.v[k, j, o])
-                    cc[r, o] = acc - uv[r, h + o] + net.b1[k, o]
+                    cc[r, o] = 0
+                for c in range(cand):  # a partner's row at a time: contiguous, vectorised
+                    j = st.idx[t, i, c]
+                    partner = st.v[k, t * n + j] if two_way else net.v[k, j]
+                    wc = w[t, i, c]
+                    for o in range(h):
+                        cc[r, o] += wc * partner[o]
+                for o in range(h):
+                    cc[r, o] = cc[r, o] - uv[r, h + o] + net.b1[k, o]
         return uv, cc
 
     @_jit
@@ -186,6 +190,7 @@ if AVAILABLE:
         n = st.idx.shape[1]
         h = net.att.shape[1]
         hk = st.h[k]
+        y_sum = np.empty(h, hk.dtype)
         for t in range(t_n):
             for i in range(n):
                 s = net.scale * 0
@@ -205,9 +210,13 @@ if AVAILABLE:
                 for i in range(lo, hi):
                     st.alpha[k, t, i] /= total
                 for o in range(h):
-                    y = net.scale * 0
-                    for i in range(lo, hi):
-                        y += st.alpha[k, t, i] * hk[t * n + i, o]
+                    y_sum[o] = 0
+                for i in range(lo, hi):  # node by node: contiguous rows
+                    alpha = st.alpha[k, t, i]
+                    for o in range(h):
+                        y_sum[o] += alpha * hk[t * n + i, o]
+                for o in range(h):
+                    y = y_sum[o]
                     col = graph * h + o
                     st.ypos[k, t, col] = y > 0
                     y = y if y > 0 else y * net.slope
