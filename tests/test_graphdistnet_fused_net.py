@@ -108,3 +108,17 @@ def test_whole_pass_serves_networks_without_node_distances():
     assert gp.load_model("d")._graphs(scene).whole is not None or not fused_kernel.AVAILABLE
     reference = GraphDistNetModel(gp.load_model("d").net, fused=False)
     assert reference._graphs(scene).whole is None
+
+
+@needs_numba
+def test_threads_split_the_batch_on_tiles_with_the_same_result():
+    scene = gp.make_scene("fetch", seed=0)
+    loaded = gp.load_model("ur5e")
+    q = scene.robot.sample(150, seed=2)  # several tiles, an uneven split
+    one, two = (GraphDistNetModel(loaded.net, card=loaded.card, threads=n) for n in (1, 2))
+    d, g = one.distance_and_grad(scene, q)
+    d2, g2 = two.distance_and_grad(scene, q)
+    np.testing.assert_array_equal(d2, d)
+    np.testing.assert_array_equal(g2, g)
+    np.testing.assert_array_equal(two.distance(scene, q), one.distance(scene, q))
+    np.testing.assert_array_equal(two.distance(scene, q[:1]), d[:1])  # one tile: one thread

@@ -33,6 +33,8 @@ rest loops. The torch reference computes the same function
 
 from __future__ import annotations
 
+import itertools
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,15 +145,31 @@ def pack(net, scene, dtype: np.dtype) -> PackedNetwork:
     return PackedNetwork(arrays._replace(**tensors), np.asarray(c.origin, dtype), c.scale, cand)
 
 
-def run(weights: PackedNetwork, nodes: np.ndarray, grad: bool) -> tuple[np.ndarray, np.ndarray]:
+def run(
+    weights: PackedNetwork, nodes: np.ndarray, grad: bool, threads: int = 1
+) -> tuple[np.ndarray, np.ndarray]:
     """d̂ (B,) (m) and, with ``grad``, ∂d̂/∂nodes (B, N_r, 2) (else an empty array) of robot
-    nodes (B, N_r, 2) (m, converted to the weights' dtype)."""
+    nodes (B, N_r, 2) (m, converted to the weights' dtype), on up to ``threads`` threads: the
+    batch split on tile boundaries (the kernel releases the GIL; every tile's result is the
+    same whichever thread runs it)."""
     dtype = weights.origin.dtype
     x = np.ascontiguousarray((nodes - weights.origin) / dtype.type(weights.scale), dtype)
     b, n_r, _ = x.shape
     d = np.empty(b, dtype)
     g = np.zeros((b, n_r, 2) if grad else (0, n_r, 2), dtype)
     tile = max(1, fused.TILE_ROWS // (3 * weights.net.ring.shape[1]))
+    tiles = -(-b // tile)
+    edges = [tile * (tiles * i // threads) for i in range(threads)] + [b]
+    parts = [slice(lo, hi) for lo, hi in itertools.pairwise(dict.fromkeys(edges)) if hi > lo]
+
+    def part(s: slice) -> None:
+        _kernels.network(x[s], weights.net, weights.candidates, d[s], g[s], tile)
+
     with fused._serial_blas():
-        _kernels.network(x, weights.net, weights.candidates, d, g, tile)
+        if len(parts) <= 1:
+            for s in parts:
+                part(s)
+        else:
+            with ThreadPoolExecutor(len(parts)) as pool:
+                list(pool.map(part, parts))
     return d, g / dtype.type(weights.scale)
