@@ -6,8 +6,9 @@ UR5e ``fetch`` scene uses ``ur5e.safetensors``), on one scene (seed 0) and the s
 random configurations: coal distance and distance + exact gradient (bounding-circle broad
 phase, batches split over all cores by processes) and GraphDistNet distance and distance +
 ∂d̂/∂q (float32, ``--threads`` torch threads) by the torch reference path (``fused=False``)
-and by the fused kernels (``fused=True``: models/graphdistnet/fused.py, and for one-way networks
-the whole-network pass of models/graphdistnet/fused_net.py), best of the repeats
+and by the fused kernels (``fused=True``: the whole-network pass of
+models/graphdistnet/fused_net.py for networks without node distances, else the ring-message
+kernels of models/graphdistnet/fused.py), best of the repeats
 after one warm-up call each, all six interleaved round by round.
 
 FLOPs: the matmul FLOPs torch runs (FlopCounterMode) plus the fused kernels' products (2 R H²
@@ -37,16 +38,18 @@ from gdnplan.assets import default_weights
 from gdnplan.models.graphdistnet import fused, fused_net
 
 
-def network_flops(x, xo, ring, tau, score, v, ax, ah, aht, b1, wht, *rest) -> int:
-    """Product FLOPs of one whole-network call (fused_net): per configuration and layer the
-    edge MLP 2·3n·L·H², the last linear layer 2·n·H², the first 2·n·2·2H (coordinates) +
-    2·n·H·2H (features, layers ≥ 1), the cross mix 2·n·C·H and the readout 4·n·H, plus the
-    head; the backward (when g_out has rows) the same again."""
-    hw, wlast, cand, g_out = rest[-10], rest[-8], rest[-6], rest[-4]
-    b, n, _ = x.shape
-    k, h = ax.shape[0], ax.shape[2] // 2
-    layer = 6 * n * wht.shape[1] * h * h + 2 * n * h * h + 8 * n * h + 2 * n * cand * h + 4 * n * h
-    forward = k * layer + (k - 1) * 4 * n * h * h + 2 * (h * hw.shape[1] + hw.size + len(wlast))
+def network_flops(x, net, cand, d_out, g_out, tile) -> int:
+    """Product FLOPs of one whole-network call (fused_net) on n rows per configuration (robot
+    nodes, plus obstacle nodes for two-way networks): per configuration and layer the edge MLP
+    2·3n·L·H², the last linear layer 2·n·H², the first 2·n·2·2H (coordinates) + 2·n·H·2H
+    (features, layers ≥ 1), the cross mix 2·n·C·H and the readout 4·n·H, plus the head
+    (P = H or 2H pooled features); the backward (when g_out has rows) the same again."""
+    b, n = x.shape[0], net.ring.shape[1]
+    k, h = net.att.shape
+    layer = 6 * n * net.wht.shape[1] * h * h + 2 * n * h * h + 8 * n * h + 2 * n * cand * h
+    layer += 4 * n * h
+    head = 2 * (net.h0t.size + net.hw.size + len(net.wlast))
+    forward = k * layer + (k - 1) * 4 * n * h * h + head
     return b * forward * (2 if g_out.shape[0] else 1)
 
 

@@ -1,14 +1,17 @@
 """Where a Table II solve's work goes: constraint evaluations, Ipopt iterations, time, cost.
 
 Plans the reaching problems of ``gdnplan.table2.reaching_problems(setting)`` (``--setting``
-d, b or fetch; default d; RRT seed 0 for every problem) with Ipopt and one collision model,
-after one warm-up plan, and reports per problem: certified or not, wall time (s), batched
-constraint evaluations (model passes), Ipopt iterations and path cost (rad²), then the medians.
+d, b or fetch; default d; RRT seed 0 for every problem) with Ipopt and one or more collision
+models (``--model GraphDistNet coal``: side by side, the models in turn on each problem, in
+alternating order), after one warm-up plan each, and reports per problem and model: certified
+or not, wall time (s), batched constraint evaluations (model passes), Ipopt iterations and
+path cost (rad²), then the medians and, for two models, the ratio of their median times.
 Evaluation and iteration counts are deterministic for a given ``--threads`` (a different count
 changes the float32 sums and so Ipopt's path), so solver settings can be compared on a busy
 machine by counts; compare times only within one run.
 
     python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet
+    python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet coal --setting fetch
     python benchmarks/planning_evaluations.py --threads 1 --model coal \
         --ipopt limited_memory_initialization=scalar1 --set ipopt.obj_change_tol=1e-4 \
         --out benchmarks/results/planning_evaluations_coal_scalar1.md
@@ -71,39 +74,71 @@ def plan_config(settings: list[str], ipopt_options: list[str]) -> PlanConfig:
 
 def main() -> None:
     p = common.parser("planning_evaluations", __doc__)
-    p.add_argument("--model", default="GraphDistNet", choices=["GraphDistNet", "coal"])
+    p.add_argument(
+        "--model",
+        nargs="+",
+        default=["GraphDistNet"],
+        choices=["GraphDistNet", "coal"],
+        help="collision model(s); several run side by side, problem by problem",
+    )
     p.add_argument("--setting", default="d", choices=list(SETTINGS))
     p.add_argument("--n", type=int, default=20)
     p.add_argument("--ipopt", nargs="*", default=[], metavar="NAME=VALUE")
     p.add_argument("--set", nargs="*", default=[], metavar="TABLE.KEY=VALUE")
     args = common.parse(p)
     cfg = plan_config(args.set, args.ipopt)
-    model_of = model_factory(args.model, args.setting)
+    models = list(dict.fromkeys(args.model))
+    factories = {m: model_factory(m, args.setting) for m in models}
     problems = reaching_problems(args.setting)[: args.n]
     report = common.Report(
         args, "Planning: evaluations per Table II solve", common.first_paragraph(__doc__)
     )
     report.text(
-        f"{args.model} constraints, setting ({args.setting}), {len(problems)} problems; "
-        f"options: ipopt={cfg.optimizer.options}, set={args.set}."
+        f"{' and '.join(models)} constraints, setting ({args.setting}), {len(problems)} "
+        f"problems (models in turn per problem, their order alternating); options: "
+        f"ipopt={cfg.optimizer.options}, set={args.set}."
     )
-    gp.plan(problems[0], collision=model_of(problems[0]), solver=cfg)  # warm-up: imports
+    for m in models:  # warm-up: imports, compilation
+        gp.plan(problems[0], collision=factories[m](problems[0]), solver=cfg)
     table = report.table(
-        "problem", "certified", "time (s)", "evaluations", "iterations", "path cost (rad²)"
+        "problem",
+        "constraints",
+        "certified",
+        "time (s)",
+        "evaluations",
+        "iterations",
+        "path cost (rad²)",
     )
-    rows = []
+    rows: dict[str, list] = {m: [] for m in models}
     for i, problem in enumerate(problems):
-        r = gp.plan(problem, collision=model_of(problem), solver=cfg)
-        rows.append((r.success, r.solve_time, r.model_calls, r.iterations, r.path_cost))
-        table.add(
-            i, r.success, f"{r.solve_time:.2f}", r.model_calls, r.iterations, f"{r.path_cost:.3f}"
+        for m in models if i % 2 == 0 else models[::-1]:
+            r = gp.plan(problem, collision=factories[m](problem), solver=cfg)
+            rows[m].append((r.success, r.solve_time, r.model_calls, r.iterations, r.path_cost))
+            table.add(
+                i,
+                m,
+                r.success,
+                f"{r.solve_time:.2f}",
+                r.model_calls,
+                r.iterations,
+                f"{r.path_cost:.3f}",
+            )
+    stats = {m: [np.array(c) for c in zip(*rows[m], strict=True)] for m in models}
+    for m, (ok, t, calls, iters, cost) in stats.items():
+        report.text(
+            f"**{m} ({args.setting}): {ok.sum()}/{len(ok)} certified, "
+            f"median time {np.median(t):.2f} s, median evaluations {np.median(calls):.1f}, "
+            f"median iterations {np.median(iters):.1f}, mean path cost {cost.mean():.3f} rad².**"
         )
-    ok, t, calls, iters, cost = (np.array(c) for c in zip(*rows, strict=True))
-    report.text(
-        f"**{args.model} ({args.setting}): {ok.sum()}/{len(ok)} certified, "
-        f"median time {np.median(t):.2f} s, median evaluations {np.median(calls):.1f}, "
-        f"median iterations {np.median(iters):.1f}, mean path cost {cost.mean():.3f} rad².**"
-    )
+    if len(models) > 1:
+        (a, sa), (b, sb) = list(stats.items())[:2]
+        both = sa[0] & sb[0]
+        report.text(
+            f"**{a} / {b}: median time {np.median(sa[1]) / np.median(sb[1]):.2f}× "
+            f"(certified {sa[0].sum()} vs {sb[0].sum()}); on the {both.sum()} problems both "
+            f"certified {np.median(sa[1][both]) / np.median(sb[1][both]):.2f}×, median of the "
+            f"per-problem ratios {np.median(sa[1][both] / sb[1][both]):.2f}×.**"
+        )
     report.write()
 
 

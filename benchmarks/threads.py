@@ -4,7 +4,9 @@ On scene ``env`` (seed 0) with its shipped weights, ``distance_and_grad`` of ``b
 configurations (64: a planner-sized call) runs under three settings, interleaved call by call
 (so a change of load hits all three alike), after a warm-up:
 
-- ``default``: the model's ``threads`` set to torch's default count (one per core);
+- ``default``: the model's ``threads`` set to torch's default count (one per core; the
+  compiled whole pass of models/graphdistnet/fused_net.py then runs its tiles on that many
+  threads);
 - ``n threads``: torch's global count n (``--threads``, 1 by default) and the model's n (no
   switching);
 - ``n threads, switched``: the caller at torch's default, the model at n (the library default):

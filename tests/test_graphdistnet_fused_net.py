@@ -1,17 +1,19 @@
-"""The whole-network pass of one-way GraphDistNet (models/graphdistnet/fused_net.py) against
-the torch reference path (``fused=False``: autograd through :meth:`GraphDistNet.lean`).
+"""The whole-network pass of GraphDistNet (models/graphdistnet/fused_net.py) against the torch
+reference path (``fused=False``: autograd through :meth:`GraphDistNet.lean`).
 
-Every shipped weights file the pass serves (one-way soft-kNN: d, e), random and near-contact
-configurations, more than one tile. Float64: d̂ and ∂d̂/∂q agree to 1e-9 relative (the same
+Every shipped weights file the pass serves (soft-kNN without node distances: one-way d, e;
+two-way b and ur5e, the planar fetch's), random and near-contact configurations, more than
+one tile. Float64: d̂ and ∂d̂/∂q agree to 1e-9 relative (the same
 function up to summation order). Float32 against a float64 truth: the yardstick is the
 reference's own float32 error. d̂ agrees with float64 to ~1e-6 m in both (asserted: 2e-6 ·
 scale); single gradients do not reach 1e-6 relative in either path, because float32
 rounding flips pre-activations within ~1e-7 of a LeakyReLU kink onto the other slope (over
-the 40 configurations here, on 2026-12-02, the 90th-percentile relative gradient error was
-5.2e-6 / 2.6e-6 whole pass and 7.1e-6 / 6.1e-6 reference on (d) / (e), the worst 1.7e-3 /
-2.7e-5 and 1.7e-3 / 5.0e-5; the largest d̂ error 1.2e-6 / 6.1e-7 m and 1.3e-6 / 6.0e-7 m).
-Asserted: the whole pass's 90th percentile under 1e-4 and at
-most 3× the reference's.
+the 40 configurations here, on 2026-12-02 with two-way networks in the pass, the
+90th-percentile relative gradient error was, whole pass / reference, 1.9e-6 / 3.3e-6 (b),
+3.7e-6 / 6.1e-6 (d), 3.6e-6 / 7.1e-6 (e), 1.2e-5 / 1.1e-5 (ur5e); the worst 1.6e-5 / 1.1e-4,
+1.7e-3 / 1.7e-3, 3.6e-5 / 4.7e-5, 6.7e-5 / 1.1e-4; the largest d̂ error 1.3e-6 m or less in
+both). Asserted: the whole pass's 90th percentile under 1e-4 and at most 3× the
+reference's.
 """
 
 import os
@@ -24,7 +26,7 @@ import gdnplan as gp
 from gdnplan.models.graphdistnet import GraphDistNetModel, fused_net
 from gdnplan.models.graphdistnet import fused as fused_kernel
 
-SERVED = ("d", "e")  # shipped weights the pass serves (scene of the same name)
+SERVED = {"b": "b", "d": "d", "e": "e", "ur5e": "fetch"}  # weights the pass serves: scene
 
 
 def test_ci_runs_the_compiled_path():
@@ -42,7 +44,7 @@ needs_numba = pytest.mark.skipif(  # in CI they run, and fail without numba
 )
 
 
-def configurations(scene: gp.Scene, n: int = 64, near: int = 16) -> np.ndarray:
+def configurations(scene: gp.Scene, n: int, near: int = 16) -> np.ndarray:
     """n random configurations and the ``near`` of 400 others closest to contact (coal)."""
     pool = scene.robot.sample(400, seed=7)
     closest = np.argsort(np.abs(gp.signed_distance(scene, pool)))[:near]
@@ -59,13 +61,18 @@ def pair(weights: str, dtype: torch.dtype) -> tuple[GraphDistNetModel, GraphDist
 
 
 @needs_numba
-@pytest.mark.parametrize("weights", SERVED)
+@pytest.mark.parametrize("weights", sorted(SERVED))
 def test_whole_pass_equals_reference_in_float64(weights):
-    scene = gp.make_scene(weights, seed=0)
-    q = configurations(scene)
+    scene = gp.make_scene(SERVED[weights], seed=0)
     whole, reference = pair(weights, torch.float64)
-    assert whole._graphs(scene).whole is not None  # the pass under test serves this network
-    assert len(q) > fused_kernel.TILE_ROWS // (3 * whole._graphs(scene).robot.n_nodes)  # tiles
+    packed = whole._graphs(scene).whole
+    assert packed is not None  # the pass under test serves this network
+    rows = packed.net.ring.shape[1]  # per configuration: robot nodes (+ obstacle nodes, two-way)
+    two_way = whole.config.two_way
+    assert rows == whole._graphs(scene).robot.n_nodes + two_way * len(packed.net.xo)
+    tile = fused_kernel.TILE_ROWS // (3 * rows)
+    q = configurations(scene, n=max(64, tile + 8))
+    assert len(q) > tile  # more than one tile
     d, g = whole.distance_and_grad(scene, q)
     d_ref, g_ref = reference.distance_and_grad(scene, q)
     assert np.abs(d_ref).min() < 0.05  # near-contact configurations are in the set
@@ -78,9 +85,9 @@ def test_whole_pass_equals_reference_in_float64(weights):
 
 
 @needs_numba
-@pytest.mark.parametrize("weights", SERVED)
+@pytest.mark.parametrize("weights", sorted(SERVED))
 def test_whole_pass_float32_is_as_accurate_as_the_reference(weights):
-    scene = gp.make_scene(weights, seed=1)
+    scene = gp.make_scene(SERVED[weights], seed=1)
     q = configurations(scene, n=24)
     exact = pair(weights, torch.float64)[1].distance_and_grad(scene, q)
     errors = []
@@ -93,11 +100,25 @@ def test_whole_pass_float32_is_as_accurate_as_the_reference(weights):
     assert whole_err <= 3 * reference_err + 1e-6
 
 
-def test_whole_pass_serves_one_way_networks_only():
-    names = {"a": "a", "b": "b", "c": "c", "d": "d", "e": "e", "ur5e": "fetch"}
+def test_whole_pass_serves_networks_without_node_distances():
+    names = ("a", "b", "c", "d", "e", "ur5e")
     served = {w for w in names if fused_net.serves(gp.load_model(w).config)}
-    assert served == set(SERVED)
+    assert served == set(SERVED)  # a and c have node distances: the ring-message kernels
     scene = gp.make_scene("d", seed=0)
     assert gp.load_model("d")._graphs(scene).whole is not None or not fused_kernel.AVAILABLE
     reference = GraphDistNetModel(gp.load_model("d").net, fused=False)
     assert reference._graphs(scene).whole is None
+
+
+@needs_numba
+def test_threads_split_the_batch_on_tiles_with_the_same_result():
+    scene = gp.make_scene("fetch", seed=0)
+    loaded = gp.load_model("ur5e")
+    q = scene.robot.sample(150, seed=2)  # several tiles, an uneven split
+    one, two = (GraphDistNetModel(loaded.net, card=loaded.card, threads=n) for n in (1, 2))
+    d, g = one.distance_and_grad(scene, q)
+    d2, g2 = two.distance_and_grad(scene, q)
+    np.testing.assert_array_equal(d2, d)
+    np.testing.assert_array_equal(g2, g)
+    np.testing.assert_array_equal(two.distance(scene, q), one.distance(scene, q))
+    np.testing.assert_array_equal(two.distance(scene, q[:1]), d[:1])  # one tile: one thread

@@ -29,10 +29,11 @@ def caller_threads():
 
 
 def graphdistnet(threads=None) -> tuple[gp.Scene, gdn.GraphDistNetModel]:
+    """A two-way soft-kNN model on the torch path (the compiled whole pass runs no torch)."""
     scene = gp.make_scene("d", seed=5)
     torch.manual_seed(0)
     net = gdn.GraphDistNet(gdn.GraphDistNetConfig.smooth(scale=scene.robot.reach))
-    return scene, gdn.GraphDistNetModel(net, threads=threads)
+    return scene, gdn.GraphDistNetModel(net, threads=threads, fused=False)
 
 
 def record_threads(monkeypatch, model: gdn.GraphDistNetModel) -> list[tuple[str, int]]:

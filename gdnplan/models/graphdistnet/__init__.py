@@ -61,16 +61,16 @@ prove it equal to :meth:`GraphDistNet.forward` (values and gradients). Where num
 (a core dependency), the edge MLP runs by the fused kernels of :mod:`.fused` instead, tile by
 tile in cache (and one-way cross terms over the candidates only); ``GraphDistNetModel(fused=…)``
 selects them (default: wherever they serve the network), tests prove them equal to the torch
-path on every shipped weights file. One-way networks without node distances run whole in
-one compiled call (:mod:`.fused_net`).
+path on every shipped weights file. Networks without node distances (one-way or two-way) run
+whole in one compiled call (:mod:`.fused_net`).
 
 Modules: :mod:`.config` (options), :mod:`.geometry` (candidates, ring distances),
 :mod:`.layers` (MLPs, readout softmax, ring messages), :mod:`.network` (the module and its
 padded forward), :mod:`.lean` (the lean inference path), :mod:`.model` (the DistanceModel
 wrapper), :mod:`.load` (weights files: :func:`load_graphdistnet_weights`), :mod:`.fused` (the
 fused numba kernels of the lean path), :mod:`.fused_net` with :mod:`.fused_net_kernels` and
-:mod:`.fused_net_backward` (the whole one-way network, forward and backward to the node
-positions, as one compiled pass: the default for the one-way soft-kNN networks it serves).
+:mod:`.fused_net_backward` (the whole network, forward and backward to the node positions,
+as one compiled pass: the default for the soft-kNN networks it serves).
 """
 
 from .config import GraphDistNetConfig

@@ -1,7 +1,9 @@
 """The reverse pass of :mod:`.fused_net` on one tile (numba; the math is in that module's
-docstring): from the state :func:`.fused_net_kernels._forward_tile` kept, ∂d̂/∂x of the tile's
-normalised robot nodes, head → readout maximum → per layer (last to first) readout softmax,
-edge MLP, [∂u ∂v], cross weights → candidates' d² → x.
+docstring): from the :class:`~.fused_net_kernels.State` the forward kept, ∂d̂/∂x of the
+tile's normalised robot nodes, head → readout maximum → per layer (last to first) readout
+softmax, edge MLP, [∂u ∂v], cross weights (two-way: and the partners' v and scores) →
+candidates' d² → x. Obstacle rows (two-way) pass their gradient on to the robot rows they
+depend on; their own coordinates are constants.
 """
 
 from __future__ import annotations
@@ -14,142 +16,182 @@ if AVAILABLE:
     from .fused import _jit
 
     @_jit
-    def _backward_tile(
-        x,
-        xo,
-        ring,
-        tau,
-        v,
-        ax,
-        aht,
-        wh,
-        wl,
-        att,
-        h0,
-        hw,
-        wlast,
-        scale,
-        slope,
-        st_idx,
-        st_near,
-        st_w,
-        st_h,
-        st_mask,
-        st_alpha,
-        st_ypos,
-        st_src,
-        st_hmask,
-        g_out,
-    ):
-        """g_out (T, n, 2) ← ∂d̂/∂x of the tile (x normalised) from :func:`_forward_tile`'s state."""
-        t_n, n, _ = x.shape
-        layers, h = att.shape
-        cand = st_idx.shape[2]
-        rows = t_n * n
-        zero = scale * 0
-        hl = hw.shape[0]
-        g = np.empty((t_n, wlast.shape[0]), x.dtype)
+    def _head_backward(net, st, t_n):
+        """(T, P) ∂d̂/∂pooled: the head's layers in reverse."""
+        hl = net.hw.shape[0]
+        r = net.wlast.shape[0]
+        g = np.empty((t_n, r), st.xu.dtype)
         for t in range(t_n):
-            for o in range(wlast.shape[0]):
-                gv = wlast[o] * scale
-                g[t, o] = gv if st_hmask[hl, t, o] else gv * slope
+            for o in range(r):
+                gv = net.wlast[o] * net.scale
+                g[t, o] = gv if st.hmask[hl, t, o] else gv * net.slope
         for layer in range(hl - 1, -1, -1):
-            g = np.dot(g, hw[layer])
+            g = np.dot(g, net.hw[layer])
             for t in range(t_n):
-                for o in range(g.shape[1]):
-                    if not st_hmask[layer, t, o]:
-                        g[t, o] *= slope
-        dy = np.dot(g, h0)  # (T, H): ∂/∂y_r
-        dh = np.zeros((rows, h), x.dtype)  # ∂/∂h⁽ᵏ⁾ from the layers above
-        dlphi = np.zeros((t_n, n, cand), x.dtype)
-        dnear = np.zeros((t_n, n, cand), x.dtype)
-        gy = np.empty(h, x.dtype)
-        da = np.empty(n, x.dtype)
-        dw = np.empty(cand, x.dtype)
-        for k in range(layers - 1, -1, -1):
-            hk = st_h[k]
-            for t in range(t_n):  # readout: y = σ(Σ α_i h_i), α = softmax a_kᵀ h
+                for o in range(r):
+                    if not st.hmask[layer, t, o]:
+                        g[t, o] *= net.slope
+        return np.dot(g, net.h0)
+
+    @_jit
+    def _readout_backward(net, st, k, t_n, n_r, dy, dh):
+        """dh (T n, H) += ∂/∂h⁽ᵏ⁾ of the readouts of layer k given dy = ∂/∂pooled (T, P)."""
+        n = st.idx.shape[1]
+        h = net.att.shape[1]
+        hk = st.h[k]
+        zero = net.scale * 0
+        gy = np.empty(h, dh.dtype)
+        da = np.empty(n, dh.dtype)
+        for t in range(t_n):
+            for graph in range(dy.shape[1] // h):
+                lo, hi = (0, n_r) if graph == 0 else (n_r, n)
                 for o in range(h):
-                    gv = dy[t, o] if st_src[t, o] == k else zero
-                    gy[o] = gv if st_ypos[k, t, o] else gv * slope
+                    col = graph * h + o
+                    gv = dy[t, col] if st.src[t, col] == k else zero
+                    gy[o] = gv if st.ypos[k, t, col] else gv * net.slope
                 mean = zero
-                for i in range(n):
+                for i in range(lo, hi):
                     acc = zero
                     for o in range(h):
                         acc += hk[t * n + i, o] * gy[o]
                     da[i] = acc
-                    alpha = st_alpha[k, t, i]
+                    alpha = st.alpha[k, t, i]
                     mean += alpha * acc
                     for o in range(h):
                         dh[t * n + i, o] += alpha * gy[o]
-                for i in range(n):
-                    ds = st_alpha[k, t, i] * (da[i] - mean)
+                for i in range(lo, hi):
+                    ds = st.alpha[k, t, i] * (da[i] - mean)
                     for o in range(h):
-                        dh[t * n + i, o] += ds * att[k, o]
-            dmsg = np.dot(dh, wl[k])
-            a = np.empty((3 * rows, h), x.dtype)
-            top = st_mask[k, st_mask.shape[1] - 1]
-            for t in range(t_n):
-                base = 3 * n * t
-                for e in range(3):
-                    for i in range(n):
-                        r = base + e * n + i
-                        for o in range(h):
-                            gv = dmsg[t * n + i, o]
-                            a[r, o] = gv if top[r, o] else gv * slope
-            for layer in range(wh.shape[1] - 1, -1, -1):
-                a = np.dot(a, wh[k, layer])
-                m = st_mask[k, layer]
-                for r in range(3 * rows):
-                    for o in range(h):
-                        if not m[r, o]:
-                            a[r, o] *= slope
-            duv = np.zeros((rows, 2 * h), x.dtype)  # [∂u, ∂v], ∂v = −∂c
-            for t in range(t_n):
-                base = 3 * n * t
+                        dh[t * n + i, o] += ds * net.att[k, o]
+
+    @_jit
+    def _edge_backward(net, st, k, t_n, dh):
+        """(duv (T n, 2H), dc (T n, H)): ∂/∂[u v] through the ring edges (∂v = −∂c) and ∂c,
+        given dh = ∂/∂h⁽ᵏ⁾."""
+        n = st.idx.shape[1]
+        h = net.att.shape[1]
+        rows = t_n * n
+        slope = net.slope
+        dmsg = np.dot(dh, net.wl[k])
+        a = np.empty((3 * rows, h), dh.dtype)
+        top = st.mask[k, st.mask.shape[1] - 1]
+        for t in range(t_n):
+            base = 3 * n * t
+            for e in range(3):
                 for i in range(n):
-                    r = t * n + i
-                    jp = t * n + ring[0, i]
-                    jn = t * n + ring[1, i]
+                    r = base + e * n + i
                     for o in range(h):
-                        gp = a[base + i, o]
-                        gn = a[base + n + i, o]
-                        duv[r, h + o] -= gp + gn + a[base + 2 * n + i, o]
-                        duv[r, o] -= gp + gn
-                        duv[jp, o] += gp
-                        duv[jn, o] += gn
-            w = st_w[k]
-            for t in range(t_n):  # cross weights, softmax, ∂ℓ → ∂d², ∂log φ; ∂x from z
-                for i in range(n):
-                    r = t * n + i
-                    mean = zero
-                    for c in range(cand):
-                        acc = zero
-                        for o in range(h):
-                            acc -= duv[r, h + o] * v[k, st_idx[t, i, c], o]
-                        dw[c] = acc
-                        mean += w[t, i, c] * acc
-                    for c in range(cand):
-                        dl = w[t, i, c] * (dw[c] - mean)
-                        dlphi[t, i, c] += dl
-                        dnear[t, i, c] -= dl / tau[k]
-                    for j in range(2):
-                        acc = zero
-                        for o in range(2 * h):
-                            acc += duv[r, o] * ax[k, j, o]
-                        g_out[t, i, j] += acc
-            if k:
-                dh = np.dot(duv, aht[k])
-        for t in range(t_n):  # log φ, then d² = |x − x_o|²
+                        gv = dmsg[t * n + i, o]
+                        a[r, o] = gv if top[r, o] else gv * slope
+        for layer in range(net.wh.shape[1] - 1, -1, -1):
+            a = np.dot(a, net.wh[k, layer])
+            m = st.mask[k, layer]
+            for r in range(3 * rows):
+                for o in range(h):
+                    if not m[r, o]:
+                        a[r, o] *= slope
+        duv = np.zeros((rows, 2 * h), dh.dtype)
+        dc = np.empty((rows, h), dh.dtype)
+        for t in range(t_n):
+            base = 3 * n * t
             for i in range(n):
-                last = st_near[t, i, cand - 1]
-                for c in range(cand - 1):
-                    delta = last - st_near[t, i, c]
+                r = t * n + i
+                jp = t * n + net.ring[0, i]
+                jn = t * n + net.ring[1, i]
+                for o in range(h):
+                    gp = a[base + i, o]
+                    gn = a[base + n + i, o]
+                    dc[r, o] = gp + gn + a[base + 2 * n + i, o]
+                    duv[r, h + o] -= dc[r, o]
+                    duv[r, o] -= gp + gn
+                    duv[jp, o] += gp
+                    duv[jn, o] += gn
+        return duv, dc
+
+    @_jit
+    def _cross_backward(net, st, k, t_n, two_way, duv, dc, dlphi, dnear, dscore):
+        """Through c = Σ_c w_c v_{j_c}: ∂w, the softmax, ∂ℓ → dlphi, dnear (T, n, C) and,
+        two-way, the partners' ∂v (into duv) and ∂s (dscore (T n,), layers k ≥ 1)."""
+        n, cand = st.idx.shape[1], st.idx.shape[2]
+        h = net.att.shape[1]
+        zero = net.scale * 0
+        w = st.w[k]
+        dw = np.empty(cand, duv.dtype)
+        for t in range(t_n):
+            for i in range(n):
+                r = t * n + i
+                mean = zero
+                for c in range(cand):
+                    j = st.idx[t, i, c]
+                    acc = zero
+                    for o in range(h):
+                        vj = st.v[k, t * n + j, o] if two_way else net.v[k, j, o]
+                        acc += dc[r, o] * vj
+                    dw[c] = acc
+                    mean += w[t, i, c] * acc
+                for c in range(cand):
+                    dl = w[t, i, c] * (dw[c] - mean)
+                    dlphi[t, i, c] += dl
+                    dnear[t, i, c] -= dl / net.tau[k]
+                    if two_way:
+                        j = t * n + st.idx[t, i, c]
+                        if k:
+                            dscore[j] += dl
+                        for o in range(h):
+                            duv[j, h + o] += w[t, i, c] * dc[r, o]
+
+    @_jit
+    def _candidates_backward(net, st, t_n, n_r, dlphi, dnear, g_out):
+        """g_out += ∂/∂x through log φ and d² = |x_robot − x_partner|² of every row's real
+        candidates (two-way obstacle rows: to their robot partners)."""
+        n, cand = st.idx.shape[1], st.idx.shape[2]
+        m = net.xo.shape[0]
+        for t in range(t_n):
+            for i in range(n):
+                real = min(cand, m if i < n_r else n_r)
+                last = st.near[t, i, real - 1]
+                for c in range(real - 1):
+                    delta = last - st.near[t, i, c]
                     if delta >= 1e-12:
                         q = dlphi[t, i, c] / delta
-                        dnear[t, i, cand - 1] += q
+                        dnear[t, i, real - 1] += q
                         dnear[t, i, c] -= q
-                for c in range(cand):
-                    j = st_idx[t, i, c]
-                    g_out[t, i, 0] += 2 * (x[t, i, 0] - xo[j, 0]) * dnear[t, i, c]
-                    g_out[t, i, 1] += 2 * (x[t, i, 1] - xo[j, 1]) * dnear[t, i, c]
+                for c in range(real):
+                    j = st.idx[t, i, c]
+                    robot, partner = (i, j) if i < n_r else (j, i)
+                    for e in range(2):
+                        p = st.xu[t, partner, e] if n > n_r else net.xo[partner, e]
+                        g_out[t, robot, e] += 2 * (st.xu[t, robot, e] - p) * dnear[t, i, c]
+
+    @_jit
+    def _backward_tile(x, net, st, g_out):
+        """g_out (T, N_r, 2) ← ∂d̂/∂x of the tile (x normalised) from the forward's state."""
+        t_n, n_r, _ = x.shape
+        n, cand = st.idx.shape[1], st.idx.shape[2]
+        layers, h = net.att.shape
+        rows = t_n * n
+        two_way = n > n_r
+        dy = _head_backward(net, st, t_n)  # (T, P)
+        dh = np.zeros((rows, h), x.dtype)  # ∂/∂h⁽ᵏ⁾ from the layers above
+        dlphi = np.zeros((t_n, n, cand), x.dtype)
+        dnear = np.zeros((t_n, n, cand), x.dtype)
+        dscore = np.zeros(rows, x.dtype)
+        for k in range(layers - 1, -1, -1):
+            _readout_backward(net, st, k, t_n, n_r, dy, dh)
+            duv, dc = _edge_backward(net, st, k, t_n, dh)
+            dscore[:] = 0
+            _cross_backward(net, st, k, t_n, two_way, duv, dc, dlphi, dnear, dscore)
+            for t in range(t_n):  # ∂x from z = (x ‖ h) (robot rows: obstacles are constants)
+                for i in range(n_r):
+                    for j in range(2):
+                        acc = net.scale * 0
+                        for o in range(2 * h):
+                            acc += duv[t * n + i, o] * net.ax[k, j, o]
+                        g_out[t, i, j] += acc
+            if k:
+                dh = np.dot(duv, net.aht[k])
+                if two_way:  # the partner scores s = a_{k−1}ᵀ h⁽ᵏ⁻¹⁾
+                    for r in range(rows):
+                        for o in range(h):
+                            dh[r, o] += dscore[r] * net.att[k - 1, o]
+        _candidates_backward(net, st, t_n, n_r, dlphi, dnear, g_out)

@@ -1,303 +1,280 @@
 """The compiled kernels of :mod:`.fused_net` (numba; the math is in that module's docstring).
 
 :func:`network` loops over tiles of configurations; per tile :func:`_forward_tile` runs the
-network and keeps what the backward needs (candidates, soft weights, signs of the
-pre-activations, features, readout weights), and with the gradient
-:func:`.fused_net_backward._backward_tile` runs the reverse pass at once. Shapes: T
-configurations per tile, n robot nodes, C candidates, K layers, H features, L hidden
-layers of the edge MLP, R readout width.
+network and keeps what the backward needs in a :class:`State` (candidates, soft weights,
+partner terms, signs of the pre-activations, features, readout weights), and with the
+gradient :func:`.fused_net_backward._backward_tile` runs the reverse pass at once. The
+network's arrays travel as one :class:`Net`. Shapes: T configurations per tile, n union rows
+per configuration (the N_r robot nodes, then for two-way networks the N_o obstacle nodes),
+C candidates, K layers, H features, P = H (one-way) or 2 H (two-way) pooled features, L
+hidden layers of the edge MLP, R readout width.
 """
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 
 from .fused import AVAILABLE
+from .geometry import PAD_DIST2
+
+NO_WEIGHT = -1e30  # log φ of a padded candidate: weight exp(−1e30) = 0 (finite: fastmath)
+
+Net = namedtuple(
+    "Net",
+    "xo ring tau score v ax ah aht b1 wht wh bh wlt wl bl3 att h0t h0 hb0 hwt hw hb wlast blast "
+    "scale slope",
+)
+Net.__doc__ = """The network and one scene's constants (:func:`.fused_net.pack`): xo (M, 2)
+obstacle nodes, ring (2, n) prev/next union rows, tau (K,), one-way partner terms score
+(K, M) and v (K, M, H) (two-way: (K, 0), (K, 0, H)), [u v] = z A_k as ax (K, 2, 2H), ah
+(K, H, 2H), aht = ahᵀ, b1 (K, H), edge MLP wht / wh (K, L, H, H) (transposed / not), bh
+(K, L, H), last layer wlt / wl (K, H, H), bl3 (K, H) = 3 b_L, att (K, H), head h0t (P, R), h0
+(R, P), hb0 (R,), hwt / hw (Lr, R, R), hb (Lr, R), wlast (R,), blast (1,), scale and the
+LeakyReLU slope (scalars of the dtype)."""
+
+State = namedtuple("State", "xu idx near lphi w v h mask logit alpha ypos src hmask")
+State.__doc__ = """Per tile: xu (T, n, 2) union coordinates, idx / near / lphi (T, n, C)
+candidates (partner rows, d², log φ), w (K, T, n, C) soft weights, v (K, T n, H) two-way
+partner terms (one-way: no rows), h (K, T n, H) features, mask (K, L + 1, 3 T n, H) signs of
+the edge pre-activations, logit / alpha (K, T, n) readout scores and weights, ypos (K, T, P)
+signs of the readouts, src (T, P) the layer of each pooled maximum, hmask (Lr + 1, T, R)
+signs of the head's pre-activations."""
 
 if AVAILABLE:
     from .fused import _jit, _leaky_rows
     from .fused_net_backward import _backward_tile
 
     @_jit
-    def _candidates(x, xo, cand, idx, near, lphi):
-        """idx, near (T, n, C): the C nearest obstacle nodes of every x (T, n, 2), ascending
-        d²; lphi = log max(d²_C − d², 1e-12)."""
-        t_n, n, _ = x.shape
-        m = xo.shape[0]
+    def _nearest(p0, p1, partners, offset, idx, near, lphi):
+        """idx, near, lphi (C,) of the point (p0, p1): its min(C, m) nearest rows of partners
+        (m, 2) (+ offset), ascending d², log φ = log max(d²_last − d², 1e-12); the rest padded
+        (d² PAD_DIST2, log φ NO_WEIGHT: weight 0)."""
+        cand = idx.shape[0]
+        real = min(cand, partners.shape[0])
+        for c in range(cand):
+            near[c] = PAD_DIST2
+            idx[c] = offset
+        for j in range(partners.shape[0]):
+            dx = p0 - partners[j, 0]
+            dy = p1 - partners[j, 1]
+            dd = dx * dx + dy * dy
+            if dd < near[real - 1]:
+                c = real - 1
+                while c > 0 and near[c - 1] > dd:
+                    near[c] = near[c - 1]
+                    idx[c] = idx[c - 1]
+                    c -= 1
+                near[c] = dd
+                idx[c] = j + offset
+        for c in range(cand):
+            lphi[c] = np.log(max(near[real - 1] - near[c], 1e-12)) if c < real else NO_WEIGHT
+
+    @_jit
+    def _candidates(x, net, st):
+        """st.xu ← the tile's union coordinates; st.idx, near, lphi ← every row's candidates:
+        robot rows among the obstacle nodes (one-way: their index; two-way: their union row),
+        obstacle rows (two-way) among the configuration's robot rows."""
+        t_n, n_r, _ = x.shape
+        n = net.ring.shape[1]
+        offset = n_r if n > n_r else 0
         for t in range(t_n):
             for i in range(n):
-                x0 = x[t, i, 0]
-                x1 = x[t, i, 1]
-                for c in range(cand):
-                    near[t, i, c] = np.inf
-                    idx[t, i, c] = 0
-                for j in range(m):
-                    dx = x0 - xo[j, 0]
-                    dy = x1 - xo[j, 1]
-                    dd = dx * dx + dy * dy
-                    if dd < near[t, i, cand - 1]:
-                        c = cand - 1
-                        while c > 0 and near[t, i, c - 1] > dd:
-                            near[t, i, c] = near[t, i, c - 1]
-                            idx[t, i, c] = idx[t, i, c - 1]
-                            c -= 1
-                        near[t, i, c] = dd
-                        idx[t, i, c] = j
-                for c in range(cand):
-                    lphi[t, i, c] = np.log(max(near[t, i, cand - 1] - near[t, i, c], 1e-12))
+                for j in range(2):
+                    st.xu[t, i, j] = x[t, i, j] if i < n_r else net.xo[i - n_r, j]
+            for i in range(n):
+                p0, p1 = st.xu[t, i, 0], st.xu[t, i, 1]
+                partners = net.xo if i < n_r else st.xu[t, :n_r]
+                base = offset if i < n_r else 0
+                _nearest(p0, p1, partners, base, st.idx[t, i], st.near[t, i], st.lphi[t, i])
 
     @_jit
-    def _forward_tile(
-        x,
-        xo,
-        ring,
-        tau,
-        score,
-        v,
-        ax,
-        ah,
-        b1,
-        wht,
-        bh,
-        wlt,
-        bl3,
-        att,
-        h0t,
-        hb0,
-        hwt,
-        hb,
-        wlast,
-        blast,
-        scale,
-        slope,
-        st_idx,
-        st_near,
-        st_lphi,
-        st_w,
-        st_h,
-        st_mask,
-        st_alpha,
-        st_ypos,
-        st_src,
-        st_hmask,
-        d_out,
-    ):
-        """d_out (T,) ← d̂ of the tile x (T, n, 2); the st_* buffers ← what the backward needs."""
-        t_n, n, _ = x.shape
-        layers, h = att.shape
-        cand = st_idx.shape[2]
-        rows = t_n * n
-        zero = scale * 0  # accumulators in the tile's dtype
-        _candidates(x, xo, cand, st_idx, st_near, st_lphi)
-        pooled = np.empty((t_n, h), x.dtype)
-        empty = np.empty(0, x.dtype)
-        for k in range(layers):
-            w = st_w[k]
-            for t in range(t_n):  # soft weights over the candidates
-                for i in range(n):
-                    top = -np.inf
-                    for c in range(cand):
-                        j = st_idx[t, i, c]
-                        lg = st_lphi[t, i, c] - st_near[t, i, c] / tau[k] + score[k, j]
-                        w[t, i, c] = lg
-                        top = max(top, lg)
-                    total = zero
-                    for c in range(cand):
-                        e = np.exp(w[t, i, c] - top)
-                        w[t, i, c] = e
-                        total += e
-                    for c in range(cand):
-                        w[t, i, c] /= total
-            if k:  # [u v] = z A_k: the h part by BLAS, the two coordinates as loops
-                uv = np.dot(st_h[k - 1, :rows], ah[k])
-            else:
-                uv = np.zeros((rows, 2 * h), x.dtype)
-            cc = np.empty((rows, h), x.dtype)
-            for t in range(t_n):
-                for i in range(n):
-                    r = t * n + i
-                    for o in range(2 * h):
-                        uv[r, o] += x[t, i, 0] * ax[k, 0, o] + x[t, i, 1] * ax[k, 1, o]
-                    for o in range(h):
-                        acc = zero
-                        for c in range(cand):
-                            acc += w[t, i, c] * v[k, st_idx[t, i, c], o]
-                        cc[r, o] = acc - uv[r, h + o] + b1[k, o]
-            a = np.empty((3 * rows, h), x.dtype)  # edge rows (prev, next, self) per config
-            for t in range(t_n):
-                base = 3 * n * t
-                for i in range(n):
-                    r = t * n + i
-                    jp = t * n + ring[0, i]
-                    jn = t * n + ring[1, i]
-                    for o in range(h):
-                        ci = cc[r, o] - uv[r, o]
-                        a[base + i, o] = uv[jp, o] + ci
-                        a[base + n + i, o] = uv[jn, o] + ci
-                        a[base + 2 * n + i, o] = cc[r, o]
-            _leaky_rows(a, empty, st_mask[k, 0], slope)
-            for layer in range(wht.shape[1]):
-                a = np.dot(a, wht[k, layer])
-                _leaky_rows(a, bh[k, layer], st_mask[k, layer + 1], slope)
-            msg = np.empty((rows, h), x.dtype)
-            for t in range(t_n):
-                base = 3 * n * t
-                for i in range(n):
-                    for o in range(h):
-                        r = base + i
-                        msg[t * n + i, o] = a[r, o] + a[r + n, o] + a[r + 2 * n, o]
-            hk = st_h[k, :rows]
-            hk[:] = np.dot(msg, wlt[k])
-            for r in range(rows):
-                for o in range(h):
-                    hk[r, o] += bl3[k, o]
-            for t in range(t_n):  # readout: α = softmax_i a_kᵀ h_i, y = σ(Σ α_i h_i), max over k
-                top = -np.inf
-                for i in range(n):
-                    s = zero
-                    for o in range(h):
-                        s += hk[t * n + i, o] * att[k, o]
-                    st_alpha[k, t, i] = s
-                    top = max(top, s)
-                total = zero
-                for i in range(n):
-                    e = np.exp(st_alpha[k, t, i] - top)
-                    st_alpha[k, t, i] = e
-                    total += e
-                for i in range(n):
-                    st_alpha[k, t, i] /= total
-                for o in range(h):
-                    y = zero
-                    for i in range(n):
-                        y += st_alpha[k, t, i] * hk[t * n + i, o]
-                    st_ypos[k, t, o] = y > 0
-                    y = y if y > 0 else y * slope
-                    if k == 0 or y > pooled[t, o]:
-                        pooled[t, o] = y
-                        st_src[t, o] = k
-        a = np.dot(pooled, h0t)  # the head (its obstacle half is in hb0)
-        _leaky_rows(a, hb0, st_hmask[0], slope)
-        for layer in range(hwt.shape[0]):
-            a = np.dot(a, hwt[layer])
-            _leaky_rows(a, hb[layer], st_hmask[layer + 1], slope)
+    def _soft_weights(net, st, k, t_n, two_way):
+        """st.w[k] ← softmax_c (log φ − d²/τ_k + s_k,j): s the partners' readout scores of
+        layer k − 1 (two-way, k ≥ 1) or the scene's (one-way)."""
+        n, cand = st.idx.shape[1], st.idx.shape[2]
+        w = st.w[k]
+        zero = net.scale * 0  # accumulators in the tile's dtype
         for t in range(t_n):
-            out = blast[0]
-            for o in range(a.shape[1]):
-                out += a[t, o] * wlast[o]
-            d_out[t] = out * scale
+            for i in range(n):
+                for c in range(cand):
+                    j = st.idx[t, i, c]
+                    if two_way:
+                        s = st.logit[k - 1, t, j] if k else zero
+                    else:
+                        s = net.score[k, j]
+                    w[t, i, c] = st.lphi[t, i, c] - st.near[t, i, c] / net.tau[k] + s
+                top = w[t, i, 0]  # the nearest candidate is never padded
+                for c in range(1, cand):
+                    top = max(top, w[t, i, c])
+                total = zero
+                for c in range(cand):
+                    e = np.exp(w[t, i, c] - top)
+                    w[t, i, c] = e
+                    total += e
+                for c in range(cand):
+                    w[t, i, c] /= total
 
     @_jit
-    def network(
-        x,
-        xo,
-        ring,
-        tau,
-        score,
-        v,
-        ax,
-        ah,
-        aht,
-        b1,
-        wht,
-        wh,
-        bh,
-        wlt,
-        wl,
-        bl3,
-        att,
-        h0t,
-        h0,
-        hb0,
-        hwt,
-        hw,
-        hb,
-        wlast,
-        blast,
-        cand,
-        d_out,
-        g_out,
-        scale,
-        slope,
-        tile,
-    ):
-        """d_out (B,) ← d̂ of normalised robot nodes x (B, n, 2); g_out (B, n, 2) ← ∂d̂/∂x
+    def _node_terms(net, st, k, t_n, two_way):
+        """(uv (T n, 2H), cc (T n, H)): [u v] = z A_k and c = Σ_c w_c v_{j_c} − v + b1."""
+        n, cand = st.idx.shape[1], st.idx.shape[2]
+        h = net.att.shape[1]
+        rows = t_n * n
+        dtype = st.xu.dtype
+        uv = np.dot(st.h[k - 1, :rows], net.ah[k]) if k else np.zeros((rows, 2 * h), dtype)
+        for t in range(t_n):
+            for i in range(n):
+                r = t * n + i
+                for o in range(2 * h):
+                    uv[r, o] += st.xu[t, i, 0] * net.ax[k, 0, o] + st.xu[t, i, 1] * net.ax[k, 1, o]
+        if two_way:  # the partners' v are this configuration's rows, kept for the backward
+            st.v[k, :rows] = uv[:, h:]
+        cc = np.empty((rows, h), dtype)
+        w = st.w[k]
+        for t in range(t_n):
+            for i in range(n):
+                r = t * n + i
+                for o in range(h):
+                    cc[r, o] = 0
+                for c in range(cand):  # a partner's row at a time: contiguous, vectorised
+                    j = st.idx[t, i, c]
+                    partner = st.v[k, t * n + j] if two_way else net.v[k, j]
+                    wc = w[t, i, c]
+                    for o in range(h):
+                        cc[r, o] += wc * partner[o]
+                for o in range(h):
+                    cc[r, o] = cc[r, o] - uv[r, h + o] + net.b1[k, o]
+        return uv, cc
+
+    @_jit
+    def _edge_mlp(net, st, k, t_n, uv, cc):
+        """st.h[k] ← W_L Σ_e g(pre_e) + 3 b_L of the tile (st.mask[k] ← the signs)."""
+        n = st.idx.shape[1]
+        h = net.att.shape[1]
+        rows = t_n * n
+        a = np.empty((3 * rows, h), st.xu.dtype)  # edge rows (prev, next, self) per config
+        for t in range(t_n):
+            base = 3 * n * t
+            for i in range(n):
+                r = t * n + i
+                jp = t * n + net.ring[0, i]
+                jn = t * n + net.ring[1, i]
+                for o in range(h):
+                    ci = cc[r, o] - uv[r, o]
+                    a[base + i, o] = uv[jp, o] + ci
+                    a[base + n + i, o] = uv[jn, o] + ci
+                    a[base + 2 * n + i, o] = cc[r, o]
+        _leaky_rows(a, np.empty(0, a.dtype), st.mask[k, 0], net.slope)
+        for layer in range(net.wht.shape[1]):
+            a = np.dot(a, net.wht[k, layer])
+            _leaky_rows(a, net.bh[k, layer], st.mask[k, layer + 1], net.slope)
+        msg = np.empty((rows, h), a.dtype)
+        for t in range(t_n):
+            base = 3 * n * t
+            for i in range(n):
+                r = base + i
+                for o in range(h):
+                    msg[t * n + i, o] = a[r, o] + a[r + n, o] + a[r + 2 * n, o]
+        hk = st.h[k, :rows]
+        hk[:] = np.dot(msg, net.wlt[k])
+        for r in range(rows):
+            for o in range(h):
+                hk[r, o] += net.bl3[k, o]
+
+    @_jit
+    def _readout(net, st, k, t_n, n_r, pooled):
+        """Per configuration and graph (robot rows, then two-way obstacle rows): α =
+        softmax_i a_kᵀ h_i, y = σ(Σ α_i h_i); pooled (T, P) ← max over the layers so far."""
+        n = st.idx.shape[1]
+        h = net.att.shape[1]
+        hk = st.h[k]
+        y_sum = np.empty(h, hk.dtype)
+        for t in range(t_n):
+            for i in range(n):
+                s = net.scale * 0
+                for o in range(h):
+                    s += hk[t * n + i, o] * net.att[k, o]
+                st.logit[k, t, i] = s
+            for graph in range(pooled.shape[1] // h):
+                lo, hi = (0, n_r) if graph == 0 else (n_r, n)
+                top = st.logit[k, t, lo]
+                for i in range(lo, hi):
+                    top = max(top, st.logit[k, t, i])
+                total = net.scale * 0
+                for i in range(lo, hi):
+                    e = np.exp(st.logit[k, t, i] - top)
+                    st.alpha[k, t, i] = e
+                    total += e
+                for i in range(lo, hi):
+                    st.alpha[k, t, i] /= total
+                for o in range(h):
+                    y_sum[o] = 0
+                for i in range(lo, hi):  # node by node: contiguous rows
+                    alpha = st.alpha[k, t, i]
+                    for o in range(h):
+                        y_sum[o] += alpha * hk[t * n + i, o]
+                for o in range(h):
+                    y = y_sum[o]
+                    col = graph * h + o
+                    st.ypos[k, t, col] = y > 0
+                    y = y if y > 0 else y * net.slope
+                    if k == 0 or y > pooled[t, col]:
+                        pooled[t, col] = y
+                        st.src[t, col] = k
+
+    @_jit
+    def _forward_tile(x, net, st, d_out):
+        """d_out (T,) ← d̂ of the tile's normalised robot nodes x (T, N_r, 2); st ← what the
+        backward needs."""
+        t_n, n_r, _ = x.shape
+        layers = net.att.shape[0]
+        two_way = net.ring.shape[1] > n_r
+        _candidates(x, net, st)
+        pooled = np.empty((t_n, net.h0t.shape[0]), x.dtype)
+        for k in range(layers):
+            _soft_weights(net, st, k, t_n, two_way)
+            uv, cc = _node_terms(net, st, k, t_n, two_way)
+            _edge_mlp(net, st, k, t_n, uv, cc)
+            _readout(net, st, k, t_n, n_r, pooled)
+        a = np.dot(pooled, net.h0t)  # the head (one-way: its obstacle half is in hb0)
+        _leaky_rows(a, net.hb0, st.hmask[0], net.slope)
+        for layer in range(net.hwt.shape[0]):
+            a = np.dot(a, net.hwt[layer])
+            _leaky_rows(a, net.hb[layer], st.hmask[layer + 1], net.slope)
+        for t in range(t_n):
+            out = net.blast[0]
+            for o in range(a.shape[1]):
+                out += a[t, o] * net.wlast[o]
+            d_out[t] = out * net.scale
+
+    @_jit
+    def network(x, net, cand, d_out, g_out, tile):
+        """d_out (B,) ← d̂ of normalised robot nodes x (B, N_r, 2); g_out (B, N_r, 2) ← ∂d̂/∂x
         (skipped when g_out has no rows), ``tile`` configurations at a time."""
-        bsz, n, _ = x.shape
-        layers, h = att.shape
-        st_idx = np.empty((tile, n, cand), np.int64)
-        st_near = np.empty((tile, n, cand), x.dtype)
-        st_lphi = np.empty((tile, n, cand), x.dtype)
-        st_w = np.empty((layers, tile, n, cand), x.dtype)
-        st_h = np.empty((layers, tile * n, h), x.dtype)
-        st_mask = np.empty((layers, wht.shape[1] + 1, 3 * tile * n, h), np.bool_)
-        st_alpha = np.empty((layers, tile, n), x.dtype)
-        st_ypos = np.empty((layers, tile, h), np.bool_)
-        st_src = np.empty((tile, h), np.int64)
-        st_hmask = np.empty((hw.shape[0] + 1, tile, wlast.shape[0]), np.bool_)
-        grad = g_out.shape[0] > 0
+        bsz, n_r, _ = x.shape
+        n = net.ring.shape[1]
+        layers, h = net.att.shape
+        dt = x.dtype
+        hidden, width = net.wht.shape[1], net.h0t.shape[0]
+        st = State(
+            np.empty((tile, n, 2), dt),
+            np.empty((tile, n, cand), np.int64),
+            np.empty((tile, n, cand), dt),
+            np.empty((tile, n, cand), dt),
+            np.empty((layers, tile, n, cand), dt),
+            np.empty((layers, tile * n if n > n_r else 0, h), dt),
+            np.empty((layers, tile * n, h), dt),
+            np.empty((layers, hidden + 1, 3 * tile * n, h), np.bool_),
+            np.empty((layers, tile, n), dt),
+            np.empty((layers, tile, n), dt),
+            np.empty((layers, tile, width), np.bool_),
+            np.empty((tile, width), np.int64),
+            np.empty((net.hw.shape[0] + 1, tile, net.wlast.shape[0]), np.bool_),
+        )
         for b0 in range(0, bsz, tile):
-            b1_ = min(b0 + tile, bsz)
-            xt = x[b0:b1_]
-            _forward_tile(
-                xt,
-                xo,
-                ring,
-                tau,
-                score,
-                v,
-                ax,
-                ah,
-                b1,
-                wht,
-                bh,
-                wlt,
-                bl3,
-                att,
-                h0t,
-                hb0,
-                hwt,
-                hb,
-                wlast,
-                blast,
-                scale,
-                slope,
-                st_idx,
-                st_near,
-                st_lphi,
-                st_w,
-                st_h,
-                st_mask,
-                st_alpha,
-                st_ypos,
-                st_src,
-                st_hmask,
-                d_out[b0:b1_],
-            )
-            if grad:
-                _backward_tile(
-                    xt,
-                    xo,
-                    ring,
-                    tau,
-                    v,
-                    ax,
-                    aht,
-                    wh,
-                    wl,
-                    att,
-                    h0,
-                    hw,
-                    wlast,
-                    scale,
-                    slope,
-                    st_idx,
-                    st_near,
-                    st_w,
-                    st_h,
-                    st_mask,
-                    st_alpha,
-                    st_ypos,
-                    st_src,
-                    st_hmask,
-                    g_out[b0:b1_],
-                )
+            b1 = min(b0 + tile, bsz)
+            _forward_tile(x[b0:b1], net, st, d_out[b0:b1])
+            if g_out.shape[0] > 0:
+                _backward_tile(x[b0:b1], net, st, g_out[b0:b1])

@@ -39,15 +39,17 @@ class GraphDistNetModel:
     :meth:`GraphDistNet.lean`, others the reference :meth:`GraphDistNet.forward`. The graphs of
     a scene are built once per scene object (scenes are immutable) and cached. Results are
     float64 numpy arrays. Inference runs with ``threads`` torch threads (None: the library
-    default, 1; :mod:`gdnplan.models.threads`), the caller's count restored after each call.
+    default, 1; :mod:`gdnplan.models.threads`), the caller's count restored after each call;
+    the compiled whole pass runs its tiles on that many threads.
 
     ``fused`` selects the kernel of the lean path's ring messages: True the fused numba kernels
     (:mod:`.fused`: on CPU, hidden layers of one width, numba installed), False the
     torch reference (:class:`~.layers._LeakyRingMessages`), None (default) the fused kernels
     where they serve the network, else the reference. The two compute the same function
-    (tests/test_graphdistnet_fused.py). With the fused kernels, one-way networks that
-    :func:`.fused_net.serves` run whole in one compiled pass (:mod:`.fused_net`: d̂ and
-    ∂d̂/∂nodes without torch; tests/test_graphdistnet_fused_net.py).
+    (tests/test_graphdistnet_fused.py). With the fused kernels, networks that
+    :func:`.fused_net.serves` (no node distances, one-way or two-way) run whole in one
+    compiled pass (:mod:`.fused_net`: d̂ and ∂d̂/∂nodes without torch;
+    tests/test_graphdistnet_fused_net.py).
     """
 
     name = "graphdistnet"
@@ -140,10 +142,11 @@ class GraphDistNetModel:
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
         """(B,) estimated signed distances (m) of q (B, dof) or (dof,)."""
         q = scene.robot.check_q(q)
-        with torch_threads(self.threads):
+        with torch_threads(self.threads) as threads:
             graphs = self._graphs(scene)  # outside inference mode: the cache serves autograd too
             if graphs.whole is not None:
-                d, _ = fused_net.run(graphs.whole, graphs.robot.positions(q), grad=False)
+                nodes = graphs.robot.positions(q)
+                d, _ = fused_net.run(graphs.whole, nodes, grad=False, threads=threads)
                 return d.astype(np.float64)
             gen = self._generator()
             with torch.inference_mode():
@@ -156,10 +159,10 @@ class GraphDistNetModel:
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad)."""
         q = scene.robot.check_q(q)
-        with torch_threads(self.threads):
+        with torch_threads(self.threads) as threads:
             graphs = self._graphs(scene)
             if graphs.whole is not None:
-                return _whole(graphs, q)
+                return _whole(graphs, q, threads)
             gen = self._generator()
             ds, gs = [], []
             for part in self._chunks(len(q), graphs):
@@ -184,10 +187,10 @@ class GraphDistNetModel:
         """
         q = scene.robot.check_q(q)
         threads = self.threads
-        with torch_threads(threads):
+        with torch_threads(threads) as count:
             graphs = self._graphs(scene)
             if graphs.whole is not None:  # the compiled pass: its gradient at once (below)
-                d, g = _whole(graphs, q)
+                d, g = _whole(graphs, q, count)
                 return d, lambda: g
             gen = self._generator()
             tapes = [self._taped(graphs, q[part], gen) for part in self._chunks(len(q), graphs)]
@@ -232,16 +235,17 @@ class _SceneCache:
     robot: RobotGraph
     obstacles: GraphBatch
     lean: SceneGraph | None
-    whole: fused_net.OneWayWeights | None = None
+    whole: fused_net.PackedNetwork | None = None
 
 
 _NUMPY = {torch.float32: np.float32, torch.float64: np.float64}
 
 
-def _whole(graphs: _SceneCache, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(d̂ (B,), ∂d̂/∂q (B, dof)) of q by the whole-network pass and the robot's pullback."""
+def _whole(graphs: _SceneCache, q: np.ndarray, threads: int) -> tuple[np.ndarray, np.ndarray]:
+    """(d̂ (B,), ∂d̂/∂q (B, dof)) of q by the whole-network pass on up to ``threads`` threads
+    and the robot's pullback."""
     nodes, joints = graphs.robot.kinematics(q)
-    d, dx = fused_net.run(graphs.whole, nodes, grad=True)
+    d, dx = fused_net.run(graphs.whole, nodes, grad=True, threads=threads)
     return d.astype(np.float64), graphs.robot.pullback(nodes, joints, dx.astype(np.float64))
 
 
