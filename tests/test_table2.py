@@ -28,6 +28,33 @@ def test_reaching_problems_are_deterministic_clear_at_the_ends_blocked_between_a
         assert gp.plan(p, collision="coal").success  # a solvable problem
 
 
+class _SlowClock:
+    """A stand-in for :mod:`time` in :mod:`gdnplan.rrt` whose clock runs ``step`` s per call:
+    a machine far slower (or busier) than this one."""
+
+    def __init__(self, step: float) -> None:
+        self.now, self.step = 0.0, step
+
+    def perf_counter(self) -> float:
+        self.now += self.step
+        return self.now
+
+
+def test_reaching_problems_do_not_depend_on_the_machines_speed(monkeypatch):
+    """The same problems on a machine whose clock runs far ahead of its RRT-Connect: the
+    selection's solvability test is an iteration cap, not a time limit (once, under load, a
+    10 s limit turned (d) problem 14 away and shifted every later index by one)."""
+    n = 3
+    fast = table2.reaching_problems("b", n=n, seed=0)
+    clock = _SlowClock(2.0)  # every clock reading 2 s after the last
+    monkeypatch.setattr(gp.rrt, "time", clock)
+    slow = table2.reaching_problems("b", n=n, seed=0)
+    assert clock.now > 10.0  # the old 10 s limit would have been passed
+    for p, q in zip(fast, slow, strict=True):
+        np.testing.assert_array_equal(p.start, q.start)
+        np.testing.assert_array_equal(p.goal, q.goal)
+
+
 def test_fetch_problems_are_unseen_random_layouts():
     problems = table2.reaching_problems("fetch", n=2, seed=0)
     assert [p.scene.seed for p in problems] == [1, 2]
