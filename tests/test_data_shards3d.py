@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 
 import numpy as np
 import pytest
@@ -122,9 +123,11 @@ def test_ray_writes_the_same_shards_as_the_local_pool(tmp_path):
     if os.environ.get("CI") != "true":
         pytest.importorskip("ray")
     local = generate3d("ur5e_boxes", 150, 4, tmp_path / "local", workers=2, near=0.2, shard_size=50)
+    before = signal.getsignal(signal.SIGTERM)
     ray = generate3d("ur5e_boxes", 150, 4, tmp_path / "ray", near=0.2, shard_size=50, ray="local")
     names = sorted(p.name for p in local.glob("shard_*.npz"))
     assert names == sorted(p.name for p in ray.glob("shard_*.npz")) and len(names) == 3
+    assert signal.getsignal(signal.SIGTERM) is before  # Ray's handler does not outlive it
     for name in names:
         assert (local / name).read_bytes() == (ray / name).read_bytes()
 

@@ -15,6 +15,7 @@ no shared file system, and the shards are the same bytes as the local pool's.
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -101,6 +102,7 @@ def _run_ray(jobs: list, address: str, bar: tqdm) -> None:
     except ImportError as e:
         raise InputError("--ray: Ray is not installed; pip install 'gdnplan[ray]'") from e
     started = not ray.is_initialized()
+    handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGINT)}
     if started:
         ray.init(address=None if address == "local" else address, include_dashboard=False)
     try:
@@ -114,3 +116,5 @@ def _run_ray(jobs: list, address: str, bar: tqdm) -> None:
     finally:
         if started:
             ray.shutdown()
+            for sig, handler in handlers.items():  # ray.init installs its own; give them back
+                signal.signal(sig, handler)
