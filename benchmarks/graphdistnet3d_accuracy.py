@@ -67,8 +67,11 @@ def main() -> None:
     args = common.parse(p)
     report = common.Report(args, "GraphDistNet-3D accuracy", common.first_paragraph(__doc__))
     net, state = best_network(args.run_dir)
+    init = state["settings"].get("init")
     report.text(
-        f"GraphDistNet-3D: {args.run_dir}, {state['samples']} training samples seen "
+        f"GraphDistNet-3D: {args.run_dir}"
+        + (f" (started from the weights {init})" if init else "")
+        + f", {state['samples']} training samples seen in this run "
         f"({state['seconds']:.0f} s of training, epoch {state['epoch']}), best validation MAE "
         f"{state['best']:.4f} m. Hidden split: {args.hidden}, first {args.n} samples."
     )

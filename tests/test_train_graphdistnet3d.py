@@ -84,3 +84,67 @@ def test_cloud_batches_use_the_knn_graph_of_each_scene():
     np.testing.assert_array_equal(b.obstacles.nbr[0].numpy(), knn.nbr)
     d, g = b.run(GraphDistNet3D(GraphDistNet3DConfig(scale=1.2)), graph, False)
     assert d.shape == (4,) and g.shape == (4, 6) and torch.isfinite(g).all()
+
+
+def _weights(tmp_path, config, seed: int = 0):
+    """A weights file of an untrained network of ``config`` (as export_weights writes it)."""
+    import torch
+
+    from gdnplan.models.graphdistnet3d import GraphDistNet3D
+    from gdnplan.models.weights import write_weights
+
+    torch.manual_seed(seed)
+    net = GraphDistNet3D(config)
+    path = tmp_path / f"w{seed}.safetensors"
+    write_weights(path, net.state_dict(), {"model": "graphdistnet3d", "config": config.to_dict()})
+    return path, net
+
+
+def test_init_starts_a_new_run_at_the_weights_function(split, tmp_path):
+    from gdnplan.train.graphdistnet3d import evaluate3d, network_config
+
+    path, net = _weights(tmp_path, network_config().with_(layers=2), seed=1)
+    assert network_config(path) == net.config
+    c = Train3DConfig(batch=25, validate_every=2, n_val=20, grad_weight=0.0, lr=0.0, min_lr=0.0)
+    run = tmp_path / "run"
+    quiet = lambda s: None  # noqa: E731
+    state = train3d(split / "train", split / "val", run, c, time_budget=0, echo=quiet, init=path)
+    assert state["log"][0]["mae_m"] == pytest.approx(evaluate3d(net, split / "val", 20)["mae_m"])
+    assert read_card(run / "checkpoint.safetensors", "c")["settings"]["init"] == str(path)
+    other = tmp_path / "other"  # without init the run's seed (0) draws another network
+    fresh = train3d(
+        split / "train", split / "val", other, c, network_config().with_(layers=2), 0, quiet
+    )
+    assert fresh["log"][0]["mae_m"] != pytest.approx(state["log"][0]["mae_m"])
+
+
+def test_init_adds_the_min_readout_to_a_plain_network(split, tmp_path):
+    import torch
+
+    from gdnplan.data.samples3d import env_robot3d
+    from gdnplan.graph3d import robot_graph3d
+    from gdnplan.models.graphdistnet3d import GraphDistNet3D, init_from_weights
+    from gdnplan.train.graphdistnet3d import Batch3D, network_config, read_shard
+
+    path, plain = _weights(tmp_path, network_config().with_(layers=2))
+    config = network_config(path, min_readout=True)
+    assert config == plain.config.with_(min_readout=True)
+    net = GraphDistNet3D(config)
+    fresh = init_from_weights(net, path)
+    assert set(fresh) == {k for k in net.state_dict() if k not in plain.state_dict()}
+    assert fresh and all(k.startswith(("node_head.", "log_tau_min")) for k in fresh)
+    graph = robot_graph3d(env_robot3d("ur5e_boxes"))
+    b = Batch3D(graph, read_shard(shard_files(split / "val")[0]), np.arange(8))
+    with torch.no_grad():  # the new readout starts at zero: the plain network's function
+        torch.testing.assert_close(b.distance(net, graph), b.distance(plain, graph))
+
+
+def test_init_refuses_weights_that_do_not_fit(tmp_path):
+    from gdnplan.models.graphdistnet3d import GraphDistNet3D, init_from_weights
+    from gdnplan.train.graphdistnet3d import network_config
+
+    path, _ = _weights(tmp_path, network_config().with_(layers=2))
+    with pytest.raises(InputError, match="does not fit"):
+        init_from_weights(GraphDistNet3D(network_config().with_(layers=3)), path)
+    with pytest.raises(InputError, match="scale"):
+        init_from_weights(GraphDistNet3D(network_config().with_(layers=2, scale=2.0)), path)

@@ -14,8 +14,15 @@ learning rate is halved after ``PLATEAU`` validations without a better MAE, the 
 kept, and a checkpoint (network, Adam, best state, position in the epoch, log) is written, so
 an interrupted run resumes at its last validation with the same command.
 
+``--init WEIGHTS`` starts a new run's network from a weights file (its card's architecture, its
+tensors; :func:`~gdnplan.models.graphdistnet3d.init_from_weights`) instead of a random draw,
+with a fresh optimiser and learning-rate schedule; ``--min-readout`` adds the soft-minimum
+readout (:class:`~gdnplan.models.graphdistnet3d.GraphDistNet3DConfig`), whose new parameters
+start so that d̂ is the initial network's.
+
     python -m gdnplan.train.graphdistnet3d --train data/ur5e_boxes/train \\
-        --val data/ur5e_boxes/test --run-dir runs/ur5e_boxes-3d [--time-budget S]
+        --val data/ur5e_boxes/test --run-dir runs/ur5e_boxes-3d [--time-budget S] \\
+        [--init weights/ur5e_boxes3d_preliminary.safetensors] [--lr 3e-4] [--min-readout]
 """
 
 from __future__ import annotations
@@ -39,7 +46,9 @@ from ..models.graphdistnet3d import (
     GraphDistNet3DConfig,
     boxes_input,
     forward_with_grad,
+    init_from_weights,
     obstacle_input,
+    read_graphdistnet3d,
     robot_tensors,
 )
 from ..models.weights import read_card, write_weights
@@ -48,7 +57,7 @@ from .loss import GraphDistNetLoss, distance_loss, gradient_loss
 from .report import git_sha, metrics
 
 CLOUD_K = 6  # neighbours of a point in a cloud's graph
-PLATEAU = 20  # validations (of 10 steps) without a better MAE before the learning rate is halved
+PLATEAU = 20  # validations without a better MAE before the learning rate is halved
 
 
 @dataclass(frozen=True)
@@ -153,6 +162,16 @@ def evaluate3d(net: GraphDistNet3D, folder: Path | str, n: int | None = None, ch
     return metrics(*arrays, reach=net.config.scale, margin=0.0)
 
 
+def network_config(init: Path | str | None = None, min_readout: bool = False):
+    """The architecture of a new run: the card's of the weights ``init`` (None: the default,
+    scaled by the UR5e's reach), with the soft-minimum readout if ``min_readout``."""
+    if init is None:
+        network = GraphDistNet3DConfig(scale=round(workspace_radius(env_robot3d("ur5e_boxes")), 6))
+    else:
+        network = GraphDistNet3DConfig.from_dict(read_graphdistnet3d(init)[1]["config"])
+    return network.with_(min_readout=True) if min_readout else network
+
+
 def train3d(
     train_dir: Path | str,
     val_dir: Path | str,
@@ -161,15 +180,17 @@ def train3d(
     network: GraphDistNet3DConfig | None = None,
     time_budget: float | None = None,
     echo=print,
+    init: Path | str | None = None,
 ) -> dict:
     """Train (or resume) a run in ``run_dir`` for ``time_budget`` seconds (None: until the
-    learning rate falls below ``min_lr``); returns the loop state (log, best, position)."""
+    learning rate falls below ``min_lr``); returns the loop state (log, best, position). A new
+    run's network starts from the weights ``init`` (:func:`init_from_weights`) if given."""
     torch.set_num_threads(1)
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     robot = env_robot3d("ur5e_boxes")
     if network is None:
-        network = GraphDistNet3DConfig(scale=round(workspace_radius(robot), 6))
+        network = network_config(init)
     shard_files(train_dir)
     shard_files(val_dir)
     graph = robot_graph3d(robot, network.rim)
@@ -183,6 +204,8 @@ def train3d(
     opt = torch.optim.Adam(net.parameters(), lr=config.lr)
     ckpt = run_dir / "checkpoint.safetensors"
     settings = {"train": asdict(config), "network": network.to_dict(), "train_dir": str(train_dir)}
+    if init is not None:
+        settings["init"] = str(init)
     state = {
         "n_files": 0,
         "epoch": 0,
@@ -203,6 +226,9 @@ def train3d(
             )
         state = load_checkpoint(ckpt, net, opt)
         echo(f"resumed {ckpt}: epoch {state['epoch']} step {state['step']}")
+    elif init is not None:
+        fresh = init_from_weights(net, init)
+        echo(f"started from {init}" + (f"; new parameters {fresh}" if fresh else ""))
     best_state = state.pop("best_state", None)
     start = time.perf_counter()
     spent0 = state["seconds"]
@@ -311,6 +337,16 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--export", type=Path, default=None, help="write the best weights + card here")
     p.add_argument("--lr", type=float, default=Train3DConfig.lr, help="initial learning rate")
     p.add_argument(
+        "--validate-every",
+        type=int,
+        default=Train3DConfig.validate_every,
+        help="training steps between validations (and checkpoints)",
+    )
+    p.add_argument("--init", type=Path, default=None, help="start the network from these weights")
+    p.add_argument(
+        "--min-readout", action="store_true", help="add the soft-minimum readout over robot nodes"
+    )
+    p.add_argument(
         "--grad-weight",
         type=float,
         default=Train3DConfig.grad_weight,
@@ -320,8 +356,9 @@ def main(argv: list[str] | None = None) -> None:
     if a.export is not None:
         print(json.dumps(export_weights(a.run_dir, a.export, a.val)["test"], indent=1))
         return
-    config = Train3DConfig(lr=a.lr, grad_weight=a.grad_weight)
-    train3d(a.train, a.val, a.run_dir, config, time_budget=a.time_budget)
+    config = Train3DConfig(lr=a.lr, grad_weight=a.grad_weight, validate_every=a.validate_every)
+    network = network_config(a.init, a.min_readout)
+    train3d(a.train, a.val, a.run_dir, config, network, a.time_budget, init=a.init)
 
 
 if __name__ == "__main__":

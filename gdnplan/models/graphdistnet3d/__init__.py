@@ -4,11 +4,11 @@
 * :mod:`.network`: :class:`GraphDistNet3D` (obstacle pass once per scene, robot pass per q);
 * :mod:`.model`: :class:`GraphDistNet3DModel`, the DistanceModel of 3-D scenes (∂d̂/∂q through
   the node Jacobians, exact self-collision beside the learned robot–obstacle distance);
-* :mod:`.load`: weights files (safetensors + JSON card).
+* :mod:`.load`: weights files (safetensors + JSON card), a network started from one.
 """
 
 from .config import GraphDistNet3DConfig
-from .load import load_graphdistnet3d
+from .load import init_from_weights, load_graphdistnet3d, read_graphdistnet3d
 from .model import (
     GraphDistNet3DModel,
     boxes_input,
@@ -26,7 +26,9 @@ __all__ = [
     "ObstacleInput",
     "boxes_input",
     "forward_with_grad",
+    "init_from_weights",
     "load_graphdistnet3d",
     "obstacle_input",
+    "read_graphdistnet3d",
     "robot_tensors",
 ]

@@ -26,6 +26,11 @@ class GraphDistNet3DConfig:
         scale: metres per unit of the net's output (the arm's reach); d̂ = scale · net output.
         origin: (x, y, z) subtracted from coordinates before scaling (the base, m).
         rim: points per cylinder rim of the robot graph (:func:`gdnplan.graph3d.robot_graph3d`).
+        min_readout: add a soft minimum over the robot nodes of a per-node distance estimate to
+            the pooled readout (:class:`~.network.GraphDistNet3D`), so that the one node near
+            contact decides d̂ instead of being averaged with the other N_r − 1. False: the
+            paper's readout alone (weights without it load unchanged).
+        tau_min: initial temperature τ_m of that soft minimum (normalised units, learned).
     """
 
     layers: int = 4
@@ -38,6 +43,8 @@ class GraphDistNet3DConfig:
     scale: float = 1.0
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rim: int = 8
+    min_readout: bool = False
+    tau_min: float = 0.05
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -46,6 +53,8 @@ class GraphDistNet3DConfig:
                 raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
         if min(self.layers, self.hidden, self.cross_k) < 1 or min(self.scale, self.tau) <= 0:
             raise InputError("layers, hidden, cross_k, tau and scale must be positive")
+        if self.tau_min <= 0:
+            raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
         if self.length <= 0:
             raise InputError(f"length: expected a positive length (m), got {self.length}")
         if len(self.origin) != 3:

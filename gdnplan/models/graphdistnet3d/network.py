@@ -20,6 +20,13 @@ the candidates does so at zero weight: d̂ is deterministic and continuous in q.
 
 Readout (paper Eq. 9–11): per graph g and layer k = 1 … K, α_i = softmax_{i∈g}(a⁽ᵏ⁾ᵀ x_i⁽ᵏ⁾),
 y_g⁽ᵏ⁾ = LeakyReLU(Σ_i α_i x_i⁽ᵏ⁾), y_g = max_k y_g⁽ᵏ⁾; d̂ = scale · MLP(y_r ‖ y_o) (m).
+The pooled sums average the node that decides contact with the other N_r − 1; ``min_readout``
+adds a term that localises it: every robot node's estimate e_i = MLP_e(x_i⁽ᴷ⁾) (normalised
+units) and their soft minimum m = −τ_m log((1/N_r) Σ_i exp(−e_i / τ_m)) (τ_m learned; between
+min_i e_i and their mean, → min_i e_i as τ_m → 0), d̂ = scale · MLP(y_r ‖ y_o) + length · m.
+MLP_e's last layer starts at zero, so m = 0 and d̂ is the pooled readout's at initialisation
+(weights of the plain network then start the new one at the same function). m is smooth in the
+node features, so d̂ stays deterministic and continuous in q.
 
 The first linear layer of h_k is applied per node (W (z_j − z_i) = W z_j − W z_i): with
 u = z W_locᵀ and v = z W_relᵀ the edge pre-activation is u_j − u_i + v̄_i − v_i + b.
@@ -92,6 +99,12 @@ class GraphDistNet3D(nn.Module):
         self.head = mlp([2 * c.hidden, *c.readout, 1])
         self.out_act = _activation()
         init_weights(self)
+        if c.min_readout:  # drawn after the plain network's parameters, which stay as without it
+            self.node_head = mlp([c.hidden, *c.readout, 1])
+            self.log_tau_min = nn.Parameter(torch.tensor(math.log(c.tau_min)))
+            _he(self.node_head)
+            with torch.no_grad():
+                self.node_head[-1].weight.zero_()  # m = 0: d̂ starts as the pooled readout's
 
     def normalise(self, p: torch.Tensor) -> torch.Tensor:
         origin = torch.as_tensor(self.config.origin, dtype=p.dtype, device=p.device)
@@ -195,7 +208,15 @@ class GraphDistNet3D(nn.Module):
             y = self.pool(h, k + 1, None)
             pooled = y if pooled is None else torch.maximum(pooled, y)
         both = torch.cat([pooled, feats.pooled.expand(b, -1)], -1)
-        return self.head(both).squeeze(-1) * self.config.scale
+        d = self.head(both).squeeze(-1) * self.config.scale
+        if not self.config.min_readout:
+            return d
+        return d + self.soft_min(self.node_head(h).squeeze(-1)) * self.config.length
+
+    def soft_min(self, e: torch.Tensor) -> torch.Tensor:
+        """m (B,) = −τ_m log((1/N) Σ_i exp(−e_i / τ_m)) of node estimates e (B, N)."""
+        tau = self.log_tau_min.exp()
+        return -tau * (torch.logsumexp(-e / tau, -1) - math.log(e.shape[-1]))
 
 
 def init_weights(net: GraphDistNet3D, degree: int = 3) -> None:
@@ -204,15 +225,20 @@ def init_weights(net: GraphDistNet3D, degree: int = 3) -> None:
     variance threefold per layer and its biases then swamp the input: d̂ hardly depends on q),
     the last layer of each h_k divided by the degree + 1 terms a message sums, and the head's
     last layer by 10 (d̂ starts near a constant, but a constant whose gradients reach every
-    layer)."""
-    for m in net.modules():
-        if isinstance(m, nn.Linear):
-            nn.init.kaiming_normal_(m.weight, a=LEAKY_SLOPE, nonlinearity="leaky_relu")
-            nn.init.zeros_(m.bias)
+    layer). (``min_readout``'s node estimates are drawn afterwards, their last layer zero.)"""
+    _he(net)
     with torch.no_grad():
         for conv in net.convs:
             conv[-1].weight /= degree + 1
         net.head[-1].weight /= 10
+
+
+def _he(module: nn.Module) -> None:
+    """He weights for LeakyReLU(0.2) and zero biases in every linear layer of ``module``."""
+    for m in module.modules():
+        if isinstance(m, nn.Linear):
+            nn.init.kaiming_normal_(m.weight, a=LEAKY_SLOPE, nonlinearity="leaky_relu")
+            nn.init.zeros_(m.bias)
 
 
 def _gather_nodes(x: torch.Tensor, idx: torch.Tensor) -> torch.Tensor:
