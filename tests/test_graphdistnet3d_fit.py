@@ -6,12 +6,14 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from gdnplan.arm3d import (
+    Robot3D,
     Scene3D,
     box_obstacle,
     cloud_obstacle,
@@ -100,8 +102,14 @@ def test_another_robot_or_its_changed_geometry_is_refused(model):
     boxes = random_boxes(load_robot3d("ur5e"), 5, seed=0).obstacles
     with pytest.raises(InputError, match="trained for robot 'ur5e', not 'panda'"):
         model.check_scene(Scene3D(load_robot3d("panda"), boxes))
-    with pytest.raises(InputError, match=r"finger opening .*moved up to 0\.0225 m"):
-        model.check_scene(Scene3D(ur5e3d(finger=OPEN_FINGER), boxes))
+    model.check_scene(Scene3D(ur5e3d(finger=OPEN_FINGER), boxes))  # fingers open: same shapes
+    ur5e = load_robot3d("ur5e")
+    placement = ur5e.shapes[0].placement.copy()
+    placement[:3, 3] += [0.0, 0.0, 0.04]  # one link shape 4 cm off: more than any finger moves
+    shapes = (replace(ur5e.shapes[0], placement=placement), *ur5e.shapes[1:])
+    moved = Robot3D("ur5e", ur5e.model, shapes, ur5e.self_pairs, {}, {})
+    with pytest.raises(InputError, match=r"other link geometry: link nodes moved up to 0\.04 m\)"):
+        model.check_scene(Scene3D(moved, boxes))
     held = hold(load_robot3d("ur5e"), *stick(0.3, 0.03))
     with pytest.raises(InputError, match=r"it holds 'stick': 240 graph nodes against 232"):
         model.check_scene(Scene3D(held, boxes))
