@@ -139,9 +139,9 @@ def _check_robot(robot: str, rim: int, scene: Scene3D) -> None:
         held = have.info.get("held")
         cause = f"it holds {held!r}" if held else "other link geometry"
         raise InputError(
-            f"scene.robot: these weights were trained on the built-in {robot}'s link geometry; this "
-            f"{robot}'s differs ({cause}: {what}), which the learned distance would not see; "
-            f"{COAL}"
+            f"scene.robot: these weights were trained on the built-in {robot}'s link geometry; "
+            f"this {robot}'s differs ({cause}: {what}), which the learned distance would not "
+            f"see; {COAL}"
         )
 
 
