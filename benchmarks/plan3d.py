@@ -3,8 +3,8 @@ or (``--learned``) gdnplan with GraphDistNet-3D constraints beside gdnplan with 
 
 Usage: python benchmarks/plan3d.py --threads 1 [--robots ur5e panda] [--problems 20]
        [--rrt-time 5] [--ompl-time 10] [--out benchmarks/results/plan3d.md]
-       python benchmarks/plan3d.py --threads 1 --robots ur5e --learned ur5e_boxes3d_preliminary \
-       --out benchmarks/results/plan3d_graphdistnet3d.md
+       python benchmarks/plan3d.py --threads 1 --robots ur5e --learned ur5e_boxes3d_preliminary
+       [--first K] --out benchmarks/results/plan3d_graphdistnet3d.md
 
 Problems: :func:`gdnplan.arm3d.problem3d.reaching_problems` (seed 0): for each robot, problem
 i is the robot among 20 random boxes (scene seed i, box sides and base clearance from
