@@ -1,7 +1,10 @@
-"""Planning in 3-D: gdnplan (coal + Ipopt) beside OMPL RRT-Connect on random reaching problems.
+"""Planning in 3-D: gdnplan (coal + Ipopt) beside OMPL RRT-Connect on random reaching problems,
+or (``--learned``) gdnplan with GraphDistNet-3D constraints beside gdnplan with coal.
 
 Usage: python benchmarks/plan3d.py --threads 1 [--robots ur5e panda] [--problems 20]
        [--rrt-time 5] [--ompl-time 10] [--out benchmarks/results/plan3d.md]
+       python benchmarks/plan3d.py --threads 1 --robots ur5e --learned ur5e_boxes3d_preliminary
+       [--first K] --out benchmarks/results/plan3d_graphdistnet3d.md
 
 Problems: :func:`gdnplan.arm3d.problem3d.reaching_problems` (seed 0): for each robot, problem
 i is the robot among 20 random boxes (scene seed i, box sides and base clearance from
@@ -18,6 +21,18 @@ Methods, on every problem in one run:
 - OMPL RRT-Connect + its path simplifier (:func:`gdnplan.ompl_planner.plan_ompl`), planning
   time limit ``--ompl-time`` s, on the same validity rule (proven state distance > margin,
   motions accepted by the same edge certificate).
+
+With ``--learned WEIGHTS`` (shipped weights by name or a ``.safetensors`` path of a
+GraphDistNet-3D card) the methods are instead ``gp.plan(problem, collision=model)`` with the
+learned robot–obstacle distance (self-collision exact; Ipopt through the same casadi callback,
+refine rounds with coal rows where the certificate fails) and ``gp.plan(problem,
+collision="coal")``, both with the same settings, run problem by problem in alternating order
+(coal first on even problems, the learned model first on odd ones) so that a drift of the
+machine's load hits both alike. Per method: certified or not, wall time, the calling thread's
+CPU time (``time.thread_time``) and the process's (``time.process_time``, every thread),
+path cost, certified clearance, batched model calls; and the median paired ratios learned /
+coal of wall and CPU time over the problems both certified. The learned model is warmed up
+once (compiled pass loaded, one scene's obstacle features) before the first problem.
 
 Every returned path is certified once more here (:func:`gdnplan.exact.certify` at the margin)
 and counts as failed unless it certifies. Metrics: success, median wall time, path cost
@@ -79,6 +94,88 @@ def run_ompl(problem, time_limit: float, seed: int) -> dict:
     }
 
 
+def run_paired(problem, collision, rrt_time: float) -> dict:
+    """gdnplan with ``collision`` (a name or a model): certified, wall / thread / process time."""
+    config = gp.PlanConfig(seed=gp.SeedConfig(rrt_time=rrt_time))
+    w0, t0, p0 = time.perf_counter(), time.thread_time(), time.process_time()
+    result = gp.plan(problem, collision=collision, solver=config)
+    wall = time.perf_counter() - w0
+    thread, process = time.thread_time() - t0, time.process_time() - p0
+    cert = certify(problem.scene, result.q, problem.certified_clearance)
+    ok = bool(result.success and cert.ok)
+    return {
+        "ok": ok,
+        "time": wall,
+        "thread": thread,
+        "process": process,
+        "calls": result.model_calls,
+        "cost": resampled_cost(result.q, problem.waypoints) if ok else None,
+        "clearance": cert.lower_bound if ok else None,
+        "note": "" if ok else result.reason[:120],
+    }
+
+
+def compare_learned(args, report: common.Report) -> None:
+    """The ``--learned`` mode: GraphDistNet-3D and coal constraints on the same problems."""
+    from gdnplan.models import load_model
+
+    model = load_model(args.learned, threads=args.threads)
+    samples = model.card.get("training", {}).get("samples")
+    report.text(
+        f"Learned model: `{args.learned}` (card: env {model.card.get('env')!r}, "
+        f"training.samples {samples}, hidden-seed AUC {model.card.get('test', {}).get('auc')}, "
+        f"compiled pass {model.fused}); RRT-Connect limit {args.rrt_time} s."
+    )
+    totals = report.table(
+        "robot", "method", "certified", "median wall (s)", "median thread CPU (s)",
+        "median process CPU (s)", "median model calls", "median path cost (rad²)",
+        "smallest certified clearance (m)",
+    )  # fmt: skip
+    ratios = report.table(
+        "robot", "problems both certified", "median wall ratio learned/coal",
+        "median thread CPU ratio", "median process CPU ratio",
+    )  # fmt: skip
+    for name in args.robots:
+        problems = reaching_problems(name, args.first + args.problems, seed=0)[args.first :]
+        model.distance_and_grad(problems[0].scene, problems[0].start[None])  # warm-up
+        detail = report.table(
+            "robot", "problem", "first", "method", "certified", "wall (s)", "thread CPU (s)",
+            "process CPU (s)", "model calls", "cost", "clearance (m)", "note",
+        )  # fmt: skip
+        rows: dict[str, list[dict]] = {"GraphDistNet-3D": [], "coal": []}
+        for i, problem in enumerate(problems, start=args.first):
+            order = ["coal", "GraphDistNet-3D"][:: 1 if i % 2 == 0 else -1]
+            for method in order:
+                r = run_paired(problem, model if method != "coal" else "coal", args.rrt_time)
+                rows[method].append(r)
+                detail.add(
+                    name, i, order[0], method, r["ok"], fmt(r["time"], ".2f"),
+                    fmt(r["thread"], ".2f"), fmt(r["process"], ".2f"), r["calls"],
+                    fmt(r["cost"]), fmt(r["clearance"], "+.4f"), r["note"],
+                )  # fmt: skip
+                report.write()  # an interrupted run keeps its rows
+        for method, results in rows.items():
+            ok = [r for r in results if r["ok"]]
+            totals.add(
+                name, method, f"{len(ok)}/{len(results)}",
+                *(fmt(statistics.median(r[k] for r in results), ".2f")
+                  for k in ("time", "thread", "process")),
+                fmt(statistics.median(r["calls"] for r in results), ".0f"),
+                fmt(statistics.median(r["cost"] for r in ok) if ok else None),
+                fmt(min(r["clearance"] for r in ok) if ok else None, "+.4f"),
+            )  # fmt: skip
+        pairs = [
+            (g, c) for g, c in zip(rows["GraphDistNet-3D"], rows["coal"], strict=True)
+            if g["ok"] and c["ok"]
+        ]  # fmt: skip
+        ratios.add(
+            name, len(pairs),
+            *(fmt(statistics.median(g[k] / c[k] for g, c in pairs) if pairs else None, ".2f")
+              for k in ("time", "thread", "process")),
+        )  # fmt: skip
+        report.write()
+
+
 def fmt(x, spec: str = ".3f") -> str:
     return "—" if x is None else format(x, spec)
 
@@ -97,7 +194,19 @@ def main(argv=None) -> None:
     p.add_argument("--problems", type=int, default=20)
     p.add_argument("--rrt-time", type=float, default=5.0, help="gdnplan's RRT-Connect limit (s)")
     p.add_argument("--ompl-time", type=float, default=10.0, help="OMPL planning time limit (s)")
+    p.add_argument(
+        "--first", type=int, default=0, help="--learned: skip the first K problems (split runs)"
+    )
+    p.add_argument(
+        "--learned",
+        metavar="WEIGHTS",
+        help="GraphDistNet-3D weights: compare learned and coal constraints instead of OMPL",
+    )
     args = common.parse(p, argv)
+    if args.learned is not None:
+        title = "Planning in 3-D: GraphDistNet-3D and coal constraints, Ipopt"
+        compare_learned(args, common.Report(args, title, __doc__))
+        return
     report = common.Report(
         args, "Planning in 3-D: gdnplan (coal + Ipopt) and OMPL RRT-Connect", __doc__
     )

@@ -23,6 +23,7 @@ BAD = [
     ["fetch", "--write-problems", "{tmp}/out"],
     ["fetch", "--3d", "--animate", "{tmp}/x.gif"],
     ["fetch", "--3d", "--collision", "graphdistnet3d"],
+    ["fetch", "--3d", "--collision", "graphdistnet"],  # was silently coal
     ["fetch", "--3d", "--write-problems", "{tmp}/a_file"],
 ]
 

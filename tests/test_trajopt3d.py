@@ -90,10 +90,10 @@ def test_adam_and_acceleration_limits_run_on_a_3d_scene():
     assert signed_distance3d(free.scene, q).min() >= curve.min_distance - 1e-9
 
 
-def test_coal_is_the_3d_model_and_no_learned_3d_model_ships():
+def test_coal_is_the_3d_model_and_learned_3d_weights_must_be_named():
     scene = wall()
     assert isinstance(resolve_model("coal", scene, None), Coal3DModel)
-    with pytest.raises(InputError, match="no learned 3-D distance model"):
+    with pytest.raises(InputError, match="on a 3-D scene needs weights named"):
         resolve_model("graphdistnet", scene, None)
 
 

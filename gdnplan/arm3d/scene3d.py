@@ -25,6 +25,8 @@ from .robot3d import Robot3D
 from .shapes import as_pose, bounding_sphere, box, capsule, convex, cylinder, load_mesh, sphere
 
 MAX_OBSTACLES = 10_000
+BOX_SIZE = (0.05, 0.2)  # m: random_boxes' default (smallest, largest) side
+BASE_CLEARANCE = 0.25  # m: random_boxes' default distance of box centres from the base axis
 
 
 @dataclass(frozen=True)
@@ -123,8 +125,8 @@ def random_boxes(
     robot: Robot3D,
     n: int = 20,
     seed: int = 0,
-    size: tuple[float, float] = (0.05, 0.2),
-    base_clearance: float = 0.25,
+    size: tuple[float, float] = BOX_SIZE,
+    base_clearance: float = BASE_CLEARANCE,
 ) -> Scene3D:
     """N random axis-aligned boxes in the arm's workspace: centres uniform in the upper half
     of the ball of radius :func:`workspace_radius` (z ≥ 0), sides uniform in ``size`` (m),

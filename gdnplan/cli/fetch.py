@@ -21,7 +21,11 @@ from .plan import echo_stages
 @app.command("fetch")
 def fetch_command(
     seed: int = typer.Option(0, min=0, help="Fetch layout: 0 canonical, others random storages."),
-    collision: str = typer.Option("graphdistnet", help="Collision model: graphdistnet or coal."),
+    collision: str = typer.Option(
+        None,
+        help="Collision model: graphdistnet or coal; default graphdistnet (planar), coal (--3d: "
+        "the only one it takes).",
+    ),
     weights: str = typer.Option(None, help=WEIGHTS_HELP),
     animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
     json_output: bool = typer.Option(False, "--json", help="Print one JSON object."),
@@ -48,7 +52,13 @@ def fetch_command(
     show_progress(not quiet)
     if three_d:
         planar_only = {"--animate": animate, "--view3d": view3d, "--weights": weights}
-        planar_only["--collision"] = collision not in ("graphdistnet", "coal") and collision
+        if collision == "graphdistnet":  # asked for by name: say why not, never plan with coal
+            raise InputError(
+                "--collision graphdistnet: the 3-D fetch plans with coal only; no GraphDistNet-3D "
+                "weights are trained on the storage and the fetch's gripper and held stick (the "
+                "shipped ur5e_boxes3d_preliminary refuse them); use --collision coal"
+            )
+        planar_only["--collision"] = collision not in (None, "coal") and collision
         for flag, value in planar_only.items():
             if value:
                 raise InputError(f"{flag}: the 3-D fetch does not take it (coal distances only)")
@@ -68,6 +78,7 @@ def fetch_command(
         from ..viz3d import require_meshcat
 
         require_meshcat()
+    collision = collision or "graphdistnet"
     stages = run_fetch(seed, collision=collision, weights=weights)
     ok = all(s.success for s in stages)
     if json_output:

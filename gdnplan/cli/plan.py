@@ -62,7 +62,8 @@ def plan_command(
     collision: str = typer.Option(
         None,
         help="Collision model: graphdistnet or coal; default: graphdistnet for a planar "
-        "problem, coal for a 3-D one (no learned 3-D model ships yet).",
+        "problem, coal for a 3-D one (graphdistnet in 3-D needs --weights, e.g. "
+        "ur5e_boxes3d_preliminary).",
     ),
     solver: str = typer.Option(
         None,

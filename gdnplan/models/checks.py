@@ -4,6 +4,8 @@ the fix.
 
 What "fit the scene" means (:func:`check_fits`):
 
+* the kind of scene: planar weights refuse a 3-D scene (:class:`~gdnplan.arm3d.Scene3D`;
+  the UR5e's planar weights would otherwise accept the 3-D UR5e by name);
 * the robot: a card names the robot its network was trained for (``"robot"``, else the robot
   of its ``"env"``; ClearanceNet's config also fixes the joint count ``dof``). Another robot is
   an error: GraphDistNet's graph input accepts any robot, but its estimates for a robot it never
@@ -30,6 +32,7 @@ import numpy as np
 import torch
 from safetensors.torch import load_file
 
+from ..arm3d.scene3d import Scene3D
 from ..errors import InputError
 from ..scene import ENV_ROBOT, Scene
 
@@ -155,6 +158,12 @@ def check_fits(card: dict, scene: Scene, dof: int | None = None) -> None:
     robot, env = card_robot(card), card.get("env")
     have = scene.robot
     source = f"{card.get('model', 'model')} weights of environment {env!r}"
+    if isinstance(scene, Scene3D):
+        raise InputError(
+            f"weights: {source} are planar and this is a 3-D scene ({have.name}, {have.dof} "
+            "joints); use GraphDistNet-3D weights (a card of model graphdistnet3d, e.g. "
+            "'ur5e_boxes3d_preliminary') or collision='coal'"
+        )
     if robot is not None and robot != have.name:
         raise InputError(
             f"weights: {source} were trained for the {robot} robot, but the scene's robot is "

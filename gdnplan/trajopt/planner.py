@@ -38,11 +38,13 @@ def resolve_model(
     """The DistanceModel named by ``collision`` ("coal", "graphdistnet" or a model instance).
 
     "coal" is the scene kind's exact model: :class:`~gdnplan.models.CoalModel` for a planar
-    scene, :class:`~gdnplan.arm3d.Coal3DModel` for a 3-D one (no learned 3-D weights ship yet).
+    scene, :class:`~gdnplan.arm3d.Coal3DModel` for a 3-D one.
 
-    ``weights`` (GraphDistNet): shipped weights by name (``"d"``) or a ``.safetensors`` path;
-    None picks the shipped weights for the scene's robot and obstacles
-    (:func:`gdnplan.assets.default_weights`).
+    ``weights`` (GraphDistNet): shipped weights by name (``"d"``, ``"ur5e_boxes3d_preliminary"``)
+    or a ``.safetensors`` path; None picks the shipped weights for a planar scene's robot and
+    obstacles (:func:`gdnplan.assets.default_weights`); a 3-D scene has no default (the
+    shipped 3-D weights are preliminary) and needs them named. The model refuses a scene it was
+    not trained for (its ``check_scene``).
     """
     if not isinstance(collision, str):
         if not isinstance(collision, DistanceModel):
@@ -57,8 +59,9 @@ def resolve_model(
         raise InputError(f"collision: unknown {collision!r}; choose 'coal' or 'graphdistnet'")
     if isinstance(scene, Scene3D) and weights is None:
         raise InputError(
-            "collision: no learned 3-D distance model ships yet; use collision='coal' (or give "
-            "3-D weights)"
+            "collision: graphdistnet on a 3-D scene needs weights named (no default: the shipped "
+            "GraphDistNet-3D weights, 'ur5e_boxes3d_preliminary', are preliminary and know the "
+            "UR5e among random boxes only); give weights=... (--weights) or use collision='coal'"
         )
     t0 = time.perf_counter()
     name = default_weights(scene) if weights is None else weights

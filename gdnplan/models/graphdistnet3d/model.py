@@ -32,6 +32,7 @@ from ...graph3d import (
 )
 from ..threads import check_threads, torch_threads
 from . import fused3d
+from .fit import check_fits3d
 from .network import GraphDistNet3D, ObstacleFeatures, ObstacleInput
 
 CHUNK = 256  # configurations per inference pass of the torch path
@@ -145,16 +146,10 @@ class GraphDistNet3DModel:
         return why is None if fused is None else fused
 
     def check_scene(self, scene: Scene3D) -> None:
-        """InputError unless ``scene`` is a Scene3D of the robot the weights were trained for."""
-        if not isinstance(scene, Scene3D):
-            raise InputError(f"scene: GraphDistNet-3D needs a Scene3D, got {type(scene).__name__}")
-        robot = self.card.get("robot")
-        if robot is not None and robot != scene.robot.name:
-            raise InputError(
-                f"scene: these weights were trained for robot {robot!r}, not {scene.robot.name!r}"
-            )
-        if not scene.obstacles:
-            raise InputError("scene.obstacles: GraphDistNet-3D needs at least one obstacle")
+        """InputError unless ``scene`` lies within what the weights were trained on: the card's
+        robot with its bare link geometry, obstacles of the card's training environment
+        (:func:`.fit.check_fits3d`)."""
+        check_fits3d(self.card, self.config.rim, scene)
 
     def _cache(self, scene: Scene3D) -> _SceneCache:
         cached = self._scenes.get(scene)
