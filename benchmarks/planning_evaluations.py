@@ -12,6 +12,8 @@ machine by counts; compare times only within one run.
 
     python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet
     python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet coal --setting fetch
+    python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet coal \
+        --setting fetch --first 10 --n 10   # problems 10-19 (halves run in parallel)
     python benchmarks/planning_evaluations.py --threads 1 --model coal \
         --ipopt limited_memory_initialization=scalar1 --set ipopt.obj_change_tol=1e-4 \
         --out benchmarks/results/planning_evaluations_coal_scalar1.md
@@ -83,20 +85,21 @@ def main() -> None:
     )
     p.add_argument("--setting", default="d", choices=list(SETTINGS))
     p.add_argument("--n", type=int, default=20)
+    p.add_argument("--first", type=int, default=0, help="index of the first problem")
     p.add_argument("--ipopt", nargs="*", default=[], metavar="NAME=VALUE")
     p.add_argument("--set", nargs="*", default=[], metavar="TABLE.KEY=VALUE")
     args = common.parse(p)
     cfg = plan_config(args.set, args.ipopt)
     models = list(dict.fromkeys(args.model))
     factories = {m: model_factory(m, args.setting) for m in models}
-    problems = reaching_problems(args.setting)[: args.n]
+    problems = reaching_problems(args.setting)[args.first : args.first + args.n]
     report = common.Report(
         args, "Planning: evaluations per Table II solve", common.first_paragraph(__doc__)
     )
     report.text(
         f"{' and '.join(models)} constraints, setting ({args.setting}), {len(problems)} "
-        f"problems (models in turn per problem, their order alternating); options: "
-        f"ipopt={cfg.optimizer.options}, set={args.set}."
+        f"problems from {args.first} (models in turn per problem, their order alternating); "
+        f"options: ipopt={cfg.optimizer.options}, set={args.set}."
     )
     for m in models:  # warm-up: imports, compilation
         gp.plan(problems[0], collision=factories[m](problems[0]), solver=cfg)
@@ -115,7 +118,7 @@ def main() -> None:
             r = gp.plan(problem, collision=factories[m](problem), solver=cfg)
             rows[m].append((r.success, r.solve_time, r.model_calls, r.iterations, r.path_cost))
             table.add(
-                i,
+                args.first + i,
                 m,
                 r.success,
                 f"{r.solve_time:.2f}",

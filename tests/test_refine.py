@@ -8,8 +8,18 @@ import pytest
 import gdnplan as gp
 from gdnplan.ccd import certify_path
 from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
-from gdnplan.trajopt.check_points import _check_point_raise, _path_parameters
-from gdnplan.trajopt.refine import ExactRows, exact_check_points, with_exact_rows
+from gdnplan.trajopt.check_points import (
+    _check_point_raise,
+    _interpolation_matrix,
+    _near_segments,
+    _path_parameters,
+)
+from gdnplan.trajopt.refine import (
+    ExactRows,
+    exact_check_points,
+    underestimated_segments,
+    with_exact_rows,
+)
 
 START, GOAL = [1.3, -2.9], [1.5, 0.1]  # planar2 around env a's square; the straight line hits it
 
@@ -84,3 +94,71 @@ def test_a_model_that_lies_everywhere_is_certified_once_coal_rows_cover_the_path
     assert certify_path(square, exact.q, p.certified_clearance).ok
     raised = RefineConfig(raise_window=None, exact_rows=False)
     assert not plan(p, collision=Liar(), solver=PlanConfig(seeds, raised)).success
+
+
+PATH = 6  # waypoints of the underestimation tests' path
+
+
+class Pessimist:
+    """Coal's distance less 0.6 m where the first joint is above −2.45 rad: a model that rates
+    a free region as in contact (its gradient coal's)."""
+
+    name = "pessimist"
+
+    def _offset(self, q):
+        return np.where(np.atleast_2d(q)[:, 0] > -2.45, 0.6, 0.0)
+
+    def distance(self, scene, q):
+        return gp.signed_distance(scene, np.atleast_2d(q)) - self._offset(q)
+
+    def distance_and_grad(self, scene, q):
+        d, g = gp.signed_distance_and_grad(scene, np.atleast_2d(q))
+        return d - self._offset(q), g
+
+
+def test_underestimated_segments_are_where_the_model_alone_violates_the_bound(square):
+    """A path (T = 6) whose first joint runs from −3.1 to −2.1 rad, clear of the square by
+    ≥ 0.5 m: the check points with q_0 > −2.45 have d̂ = d − 0.6 m below the bound while coal
+    clears it, so exactly the segments holding one (ends included) are marked, with the window
+    either side; coal itself marks nothing, and neither does a bound below every d̂."""
+    q = np.linspace([-3.1, -1.0], [-2.1, -1.0], PATH)
+    splits = np.full(PATH - 1, 3)
+    points = _interpolation_matrix(splits)[1:-1] @ q
+    bound = 0.04
+    assert np.all(gp.signed_distance(square, points) >= bound + 0.4)  # the premise
+    marked = underestimated_segments(square, Pessimist(), q, splits, bound, 0)
+    s = _path_parameters(splits)[1:-1]
+    low = points[:, 0] > -2.45
+    expected = np.array([np.any(low & (s >= t) & (s <= t + 1)) for t in range(PATH - 1)])
+    assert marked.tolist() == expected.tolist() and marked.any() and not marked.all()
+    wide = underestimated_segments(square, Pessimist(), q, splits, bound, 1)
+    assert wide.tolist() == _near_segments(np.flatnonzero(expected).tolist(), PATH - 1, 1).tolist()
+    assert not underestimated_segments(square, gp.CoalModel(), q, splits, bound, None).any()
+    assert not underestimated_segments(square, Pessimist(), q, splits, -1.0, None).any()
+
+
+def test_coal_rows_before_the_first_solve_where_the_model_underestimates(square, monkeypatch):
+    """_solve_refined builds its first NLP with coal rows on the underestimated segments: the
+    distance model of the first transcription is ExactRows with those check points exact."""
+    from gdnplan.trajopt import ipopt as ipopt_module
+
+    seen = []
+    real = ipopt_module._Transcription
+
+    def spy(problem, model, *args, **kwargs):
+        seen.append(model)
+        return real(problem, model, *args, **kwargs)
+
+    monkeypatch.setattr(ipopt_module, "_Transcription", spy)
+    q = np.linspace([-3.1, -1.0], [-2.1, -1.0], PATH)
+    p = Problem(scene=square, start=q[0], goal=q[-1], waypoints=PATH, margin=0.04)
+    cfg = PlanConfig(refine=RefineConfig(rounds=0, raise_window=0))
+    run = ipopt_module._Run(q=q)
+    ipopt_module._solve_refined(p, Pessimist(), q[-1], cfg, q, run)
+    first = seen[0]
+    assert isinstance(first, ExactRows)
+    splits = np.full(PATH - 1, cfg.optimizer.interpolated + 1)
+    margin = ipopt_module.constraint_margin(p, cfg.refine.clearance_buffer)
+    marked = underestimated_segments(square, Pessimist(), q, splits, margin, 0)
+    assert marked.any()
+    assert first.exact.tolist() == exact_check_points(splits, marked).tolist()

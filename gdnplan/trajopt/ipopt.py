@@ -25,7 +25,7 @@ from .check_points import (
 )
 from .config import PlanConfig
 from .problem import Problem
-from .refine import with_exact_rows
+from .refine import underestimated_segments, with_exact_rows
 from .result import _Run, path_cost
 from .seeds import SeedInfo, draw_seed
 from .transcription import _Transcription
@@ -145,7 +145,9 @@ def _solve_refined(
     Each round that the coal certificate rejects doubles the check points of the rejected
     segments and, for a learned model, gives the check points of the rejected segments and
     ``raise_window`` segments either side coal rows (``RefineConfig.exact_rows``,
-    :mod:`gdnplan.trajopt.refine`); without exact rows it raises the constraint margin to the
+    :mod:`gdnplan.trajopt.refine`), and before the first round so do the segments where the
+    model alone violates the bound at ``guess`` (:func:`~.refine.underestimated_segments`);
+    without exact rows it raises the constraint margin to the
     model's observed overestimate there (:func:`model_overestimate`) on the rejected segments and
     ``raise_window`` segments either side: the learned constraint then keeps the path away
     from the contact coal found, whatever the model's error (on the rejected segments alone
@@ -164,6 +166,10 @@ def _solve_refined(
     margin = constraint_margin(problem, refine.clearance_buffer)  # above the certified clearance
     raised = np.zeros(len(splits))  # margin raise of each segment (m)
     exact = np.zeros(len(splits), bool)  # segments whose check points have coal rows
+    if exact_rows:  # coal rows where the model alone violates the bound (refine.py)
+        exact = underestimated_segments(
+            problem.scene, model, guess, splits, margin, refine.raise_window
+        )
     q, duals, stats = guess, None, {"return_status": "time budget ended"}
     for round_ in range(1 + (refine.rounds if refine.ccd else 0)):
         t0 = time.perf_counter()

@@ -8,7 +8,16 @@ path is not the error after the path moves, and a raised bound pushes the whole 
 out (a detour). Exact rows replace, at the check points of the rejected segments (and
 ``raise_window`` segments either side), the row d̂(p_k) ≥ b_k by d_coal(p_k) ≥ b_k: the bound
 needs no raise there and is the true distance wherever the path moves; the other check points
-keep the learned model. Coal's gradient is its closest-pair witness gradient
+keep the learned model.
+
+A learned model also underestimates the distance somewhere (on the fetch layouts: next to the
+grasp, fingers around the stick, d̂ ≈ 4 mm where coal finds 24 mm). Where the solve's starting
+path has d̂(p_k) < b_k ≤ d_coal(p_k), its row is violated by the model's error alone and Ipopt
+spends its iterations pushing the path out of a region that is in fact free (on fetch layout 0,
+two of three seeds ran to the iteration cap). :func:`underestimated_segments` marks those
+segments (and ``raise_window`` either side) for coal rows before the first solve: the same
+bound on the true distance, so the margin rule and the certificate are unchanged. Coal's
+gradient is its closest-pair witness gradient
 (:func:`gdnplan.distance.signed_distance_and_grad`; in 3-D
 :func:`gdnplan.arm3d.signed_distance3d_and_grad`).
 """
@@ -24,7 +33,12 @@ from ..arm3d.scene3d import Scene3D
 from ..distance import signed_distance, signed_distance_and_grad
 from ..models import DistanceModel
 from ..scene import Scene
-from .check_points import _check_point_raise
+from .check_points import (
+    _check_point_raise,
+    _interpolation_matrix,
+    _near_segments,
+    _path_parameters,
+)
 
 
 def _exact(scene: Scene | Scene3D, q: np.ndarray) -> np.ndarray:
@@ -105,6 +119,31 @@ class ExactRows:
         return d, grad
 
 
+def underestimated_segments(
+    scene: Scene | Scene3D,
+    model: DistanceModel,
+    q: np.ndarray,
+    splits: np.ndarray,
+    bound: np.ndarray | float,
+    window: int | None,
+) -> np.ndarray:
+    """(T − 1,) bool: the segments of the path q (T, dof) holding an inner check point of
+    ``splits`` with d̂(p_k) < b_k ≤ d_coal(p_k) (the model alone violates the bound ``bound``
+    (K,) or scalar, m), and ``window`` segments either side of each (all when None); a waypoint
+    check point marks both its segments. Costs one model and one coal call on the K points."""
+    points = _interpolation_matrix(splits)[1:-1] @ q
+    bound = np.broadcast_to(np.asarray(bound, float), (len(points),))
+    low = model.distance(scene, points) < bound
+    if low.any():
+        low[low] = _exact(scene, points[low]) >= bound[low]
+    if not low.any():
+        return np.zeros(len(splits), bool)
+    s = _path_parameters(splits)[1:-1][low]
+    last = len(splits) - 1
+    hits = np.unique(np.concatenate([np.minimum(np.floor(s), last), np.ceil(s) - 1]))
+    return _near_segments(hits.astype(int).tolist(), len(splits), window)
+
+
 def with_exact_rows(model: DistanceModel, splits: np.ndarray, exact: np.ndarray) -> DistanceModel:
     """``model`` with coal rows at the check points of the segments ``exact`` (T − 1,) bool
     (:class:`ExactRows`); ``model`` itself when no segment is marked."""
@@ -113,4 +152,4 @@ def with_exact_rows(model: DistanceModel, splits: np.ndarray, exact: np.ndarray)
     return ExactRows(model, exact_check_points(splits, exact))
 
 
-__all__ = ["ExactRows", "exact_check_points", "with_exact_rows"]
+__all__ = ["ExactRows", "exact_check_points", "underestimated_segments", "with_exact_rows"]

@@ -87,9 +87,8 @@ if AVAILABLE:
             a = np.dot(a, net.wh[k, layer])
             m = st.mask[k, layer]
             for r in range(3 * rows):
-                for o in range(h):
-                    if not m[r, o]:
-                        a[r, o] *= slope
+                for o in range(h):  # a select, not a branch: vectorised
+                    a[r, o] = a[r, o] if m[r, o] else a[r, o] * slope
         duv = np.zeros((rows, 2 * h), dh.dtype)
         dc = np.empty((rows, h), dh.dtype)
         for t in range(t_n):

@@ -133,19 +133,18 @@ if AVAILABLE:
             st.v[k, :rows] = uv[:, h:]
         cc = np.empty((rows, h), dtype)
         w = st.w[k]
+        partners = st.v[k] if two_way else net.v[k]  # (T n, H) this tile's rows, or (M, H)
         for t in range(t_n):
+            base = t * n if two_way else 0
             for i in range(n):
                 r = t * n + i
                 for o in range(h):
-                    cc[r, o] = 0
+                    cc[r, o] = net.b1[k, o] - uv[r, h + o]
                 for c in range(cand):  # a partner's row at a time: contiguous, vectorised
-                    j = st.idx[t, i, c]
-                    partner = st.v[k, t * n + j] if two_way else net.v[k, j]
+                    row = base + st.idx[t, i, c]
                     wc = w[t, i, c]
                     for o in range(h):
-                        cc[r, o] += wc * partner[o]
-                for o in range(h):
-                    cc[r, o] = cc[r, o] - uv[r, h + o] + net.b1[k, o]
+                        cc[r, o] += wc * partners[row, o]
         return uv, cc
 
     @_jit
