@@ -25,10 +25,10 @@ from pathlib import Path
 import coal
 import numpy as np
 
-from ..errors import InputError, UnknownNameError
+from ..errors import InputError
 from ..limits import is_number
 from .scene3d import Obstacle3D, obstacle
-from .shapes import MAX_COORDINATE
+from .shapes import as_points, existing_file
 
 MAX_CLOUD_POINTS = 2_000_000  # points of one cloud
 MIN_RESOLUTION = 1e-3  # m: smallest voxel edge
@@ -39,20 +39,8 @@ DEFAULT_RESOLUTION = 0.02  # m
 
 def cloud_points(points, name: str) -> np.ndarray:
     """A finite float (k, 3) point array, 1 ≤ k ≤ MAX_CLOUD_POINTS, |x| ≤ MAX_COORDINATE m;
-    else InputError."""
-    try:
-        pts = np.asarray(points, dtype=float)
-    except (TypeError, ValueError) as e:
-        raise InputError(f"{name}: expected points of shape (k, 3), got {type(points)}") from e
-    if pts.ndim != 2 or pts.shape[1] != 3 or not 1 <= len(pts) <= MAX_CLOUD_POINTS:
-        raise InputError(
-            f"{name}: expected (k, 3) points with 1 ≤ k ≤ {MAX_CLOUD_POINTS}, got {pts.shape}"
-        )
-    if not np.all(np.isfinite(pts)):
-        raise InputError(f"{name}: contains NaN or infinite coordinates")
-    if np.max(np.abs(pts)) > MAX_COORDINATE:
-        raise InputError(f"{name}: coordinates beyond {MAX_COORDINATE:g} m; use metres")
-    return pts
+    else InputError (:func:`~gdnplan.arm3d.shapes.as_points`)."""
+    return as_points(points, name, min_points=1, max_points=MAX_CLOUD_POINTS)
 
 
 def cloud_resolution(value, name: str) -> float:
@@ -68,7 +56,11 @@ def cloud_resolution(value, name: str) -> float:
 
 def octree(points, resolution: float = DEFAULT_RESOLUTION, name: str = "cloud") -> coal.OcTree:
     """The coal octree of ``points`` (k, 3) at voxel edge ``resolution`` (m); see the module."""
-    pts = cloud_points(points, f"{name}.points")
+    return _octree(cloud_points(points, f"{name}.points"), resolution, name)
+
+
+def _octree(pts: np.ndarray, resolution, name: str) -> coal.OcTree:
+    """:func:`octree` of points already checked by :func:`cloud_points`."""
     r = cloud_resolution(resolution, f"{name}.resolution")
     reach = float(np.max(np.abs(pts)))
     if reach >= 0.999 * r * OCTREE_HALF_CELLS:
@@ -90,19 +82,13 @@ def cloud_obstacle(
     """A point cloud (k, 3) in the obstacle's frame (m) as an octree obstacle of voxel edge
     ``resolution`` (m), posed by ``position`` and ``rotation``; it keeps its points."""
     pts = cloud_points(points, f"{name}.points")
-    return replace(obstacle(octree(pts, resolution, name), position, rotation, name), points=pts)
+    return replace(obstacle(_octree(pts, resolution, name), position, rotation, name), points=pts)
 
 
 def read_cloud(path: Path | str, name: str = "cloud") -> np.ndarray:
     """The (k, 3) points of a ``.npy`` file or a text file of ``x y z`` / ``x, y, z`` lines (m);
     UnknownNameError for a missing file, InputError for one that holds no such points."""
-    path = Path(path)
-    try:
-        found = path.is_file()
-    except (OSError, ValueError):
-        found = False
-    if not found:
-        raise UnknownNameError(f"{name}: point file {path} does not exist (or is not a file)")
+    path = existing_file(path, f"{name}: point file")
     try:
         if path.suffix.lower() == ".npy":
             pts = np.load(path, allow_pickle=False)

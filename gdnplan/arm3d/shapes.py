@@ -66,15 +66,18 @@ def as_size(value, name: str) -> float:
     return float(value)
 
 
-def as_points(points, name: str) -> np.ndarray:
-    """A finite, bounded float (k, 3) point array (4 ≤ k ≤ MAX_HULL_POINTS), else InputError."""
+def as_points(
+    points, name: str, min_points: int = 4, max_points: int = MAX_HULL_POINTS
+) -> np.ndarray:
+    """A finite, bounded float (k, 3) point array (min_points ≤ k ≤ max_points; the defaults:
+    a convex hull's), else InputError."""
     try:
         pts = np.asarray(points, dtype=float)
     except (TypeError, ValueError) as e:
         raise InputError(f"{name}: expected points of shape (k, 3), got {type(points)}") from e
-    if pts.ndim != 2 or pts.shape[1] != 3 or not 4 <= len(pts) <= MAX_HULL_POINTS:
+    if pts.ndim != 2 or pts.shape[1] != 3 or not min_points <= len(pts) <= max_points:
         raise InputError(
-            f"{name}: expected (k, 3) points with 4 ≤ k ≤ {MAX_HULL_POINTS}, got {pts.shape}"
+            f"{name}: expected (k, 3) points with {min_points} ≤ k ≤ {max_points}, got {pts.shape}"
         )
     if not np.all(np.isfinite(pts)):
         raise InputError(f"{name}: contains NaN or infinite coordinates")
@@ -170,19 +173,25 @@ def _deepest_inside(pts: np.ndarray, hull: ConvexHull) -> float:
     return float(np.max(-np.max(offsets, axis=0)))
 
 
+def existing_file(path, what: str) -> Path:
+    """``path`` as a Path, UnknownNameError "<what> <path> does not exist" unless it is a file."""
+    path = Path(path)
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):  # a name too long, a NUL byte
+        found = False
+    if not found:
+        raise UnknownNameError(f"{what} {path} does not exist (or is not a file)")
+    return path
+
+
 def load_mesh(path, scale=(1.0, 1.0, 1.0), name: str = "mesh") -> coal.ConvexBase:
     """The convex hull of the mesh file ``path`` (STL, OBJ, DAE, … via coal's assimp loader).
 
     ``scale``: per-axis factors applied to the file's coordinates (a file in millimetres
     needs 1e-3). UnknownNameError for a missing file, InputError for one that is not a mesh.
     """
-    path = Path(path)
-    try:
-        found = path.is_file()
-    except (OSError, ValueError):
-        found = False
-    if not found:
-        raise UnknownNameError(f"{name}: mesh file {path} does not exist (or is not a file)")
+    path = existing_file(path, f"{name}: mesh file")
     factors = np.asarray(scale, dtype=float)
     if factors.shape != (3,) or not np.all(np.isfinite(factors)) or np.any(factors <= 0):
         raise InputError(f"{name}.scale: expected three positive numbers, got {scale!r}")
