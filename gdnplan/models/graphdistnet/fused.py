@@ -84,6 +84,32 @@ if AVAILABLE:
     _jit = numba.njit(cache=True, fastmath=True, nogil=True)
 
     @_jit
+    def _softmax_inplace(w):
+        """w (C,) ← softmax(w), the largest entry subtracted first."""
+        top = w[0]
+        for c in range(1, w.shape[0]):
+            top = max(top, w[c])
+        total = w[0] * 0
+        for c in range(w.shape[0]):
+            e = np.exp(w[c] - top)
+            w[c] = e
+            total += e
+        for c in range(w.shape[0]):
+            w[c] /= total
+
+    @_jit
+    def _log_phi_backward(near, dlphi, dnear, real):
+        """dnear (C,) += ∂/∂d² of Σ_c dlphi_c log φ_c, φ_c = d²_{real−1} − d²_c, over one
+        node's first ``real`` candidates (φ floored at 1e-12 has no gradient)."""
+        last = near[real - 1]
+        for c in range(real - 1):
+            delta = last - near[c]
+            if delta >= 1e-12:
+                q = dlphi[c] / delta
+                dnear[real - 1] += q
+                dnear[c] -= q
+
+    @_jit
     def _leaky_rows(a, bias, mask, slope):
         """a ← σ(a + bias) row by row (a (R, H), bias (H,) or empty); mask ← a > 0 (or skip)."""
         rows, h = a.shape

@@ -13,7 +13,7 @@ import numpy as np
 from .fused import AVAILABLE
 
 if AVAILABLE:
-    from .fused import _jit
+    from .fused import _jit, _log_phi_backward
 
     @_jit
     def _head_backward(net, st, t_n):
@@ -148,13 +148,7 @@ if AVAILABLE:
         for t in range(t_n):
             for i in range(n):
                 real = min(cand, m if i < n_r else n_r)
-                last = st.near[t, i, real - 1]
-                for c in range(real - 1):
-                    delta = last - st.near[t, i, c]
-                    if delta >= 1e-12:
-                        q = dlphi[t, i, c] / delta
-                        dnear[t, i, real - 1] += q
-                        dnear[t, i, c] -= q
+                _log_phi_backward(st.near[t, i], dlphi[t, i], dnear[t, i], real)
                 for c in range(real):
                     j = st.idx[t, i, c]
                     robot, partner = (i, j) if i < n_r else (j, i)

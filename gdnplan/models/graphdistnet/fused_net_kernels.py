@@ -43,7 +43,7 @@ signs of the readouts, src (T, P) the layer of each pooled maximum, hmask (Lr + 
 signs of the head's pre-activations."""
 
 if AVAILABLE:
-    from .fused import _jit, _leaky_rows
+    from .fused import _jit, _leaky_rows, _softmax_inplace
     from .fused_net_backward import _backward_tile
 
     @_jit
@@ -105,16 +105,7 @@ if AVAILABLE:
                     else:
                         s = net.score[k, j]
                     w[t, i, c] = st.lphi[t, i, c] - st.near[t, i, c] / net.tau[k] + s
-                top = w[t, i, 0]  # the nearest candidate is never padded
-                for c in range(1, cand):
-                    top = max(top, w[t, i, c])
-                total = zero
-                for c in range(cand):
-                    e = np.exp(w[t, i, c] - top)
-                    w[t, i, c] = e
-                    total += e
-                for c in range(cand):
-                    w[t, i, c] /= total
+                _softmax_inplace(w[t, i])  # the nearest candidate is never padded
 
     @_jit
     def _node_terms(net, st, k, t_n, two_way):

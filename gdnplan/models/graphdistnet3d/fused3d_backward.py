@@ -12,7 +12,7 @@ import numpy as np
 from ..graphdistnet.fused import AVAILABLE
 
 if AVAILABLE:
-    from ..graphdistnet.fused import _jit
+    from ..graphdistnet.fused import _jit, _log_phi_backward
 
     @_jit
     def _head_backward(wts, st, t_n, scale, slope):
@@ -147,13 +147,7 @@ if AVAILABLE:
                 dh = np.dot(duv, wts.aht[k])
         for t in range(t_n):  # log φ, then d² = |x − x_o|²
             for i in range(n):
-                last = st.near[t, i, cand - 1]
-                for c in range(cand - 1):
-                    delta = last - st.near[t, i, c]
-                    if delta >= 1e-12:
-                        q = dlphi[t, i, c] / delta
-                        dnear[t, i, cand - 1] += q
-                        dnear[t, i, c] -= q
+                _log_phi_backward(st.near[t, i], dlphi[t, i], dnear[t, i], cand)
                 for c in range(cand):
                     j = st.idx[t, i, c]
                     for d in range(3):

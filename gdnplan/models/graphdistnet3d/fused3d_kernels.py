@@ -82,7 +82,7 @@ class State(NamedTuple):
 
 
 if AVAILABLE:
-    from ..graphdistnet.fused import _jit, _leaky_rows
+    from ..graphdistnet.fused import _jit, _leaky_rows, _softmax_inplace
     from .fused3d_backward import _backward_tile
 
     @_jit
@@ -125,19 +125,10 @@ if AVAILABLE:
         n, cand = st.idx.shape[1], st.idx.shape[2]
         for t in range(t_n):
             for i in range(n):
-                top = st.lphi[t, i, 0] * 0 + st.lphi[t, i, 0]  # the tile's dtype
                 for c in range(cand):
                     lg = st.lphi[t, i, c] - st.near[t, i, c] / wts.tau[k]
-                    lg += wts.score[k, st.idx[t, i, c]]
-                    w[t, i, c] = lg
-                    top = lg if c == 0 else max(top, lg)
-                total = w[t, i, 0] * 0
-                for c in range(cand):
-                    e = np.exp(w[t, i, c] - top)
-                    w[t, i, c] = e
-                    total += e
-                for c in range(cand):
-                    w[t, i, c] /= total
+                    w[t, i, c] = lg + wts.score[k, st.idx[t, i, c]]
+                _softmax_inplace(w[t, i])
 
     @_jit
     def _readout(k, hk, wts, st, pooled, slope):
