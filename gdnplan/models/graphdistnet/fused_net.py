@@ -36,6 +36,7 @@ from __future__ import annotations
 import itertools
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import torch
@@ -79,6 +80,33 @@ def _np(t: torch.Tensor, dtype: np.dtype) -> np.ndarray:
     return np.ascontiguousarray(t.detach().cpu().double().numpy().astype(dtype))
 
 
+class ConvBlocks(NamedTuple):
+    """One message layer h_k as the compiled passes use it: ``a`` (d, 2P) with [u v] = z a
+    for z = (x ‖ h) of d features, ``b1`` (P,) its first bias, ``wh`` (L, P, P) / ``bh`` (L, P)
+    the hidden layers (L may be 0), ``wl`` / ``bl`` the last layer."""
+
+    a: torch.Tensor
+    b1: torch.Tensor
+    wh: torch.Tensor
+    bh: torch.Tensor
+    wl: torch.Tensor
+    bl: torch.Tensor
+
+
+def conv_blocks(conv) -> ConvBlocks:
+    """:class:`ConvBlocks` of a layer ``conv`` (Linear, activations, …, Linear) whose first
+    Linear sees (z_j − z_i ‖ z̄_i − z_i) of z = (x ‖ h): the coordinates are a's first rows."""
+    first, *rest = conv
+    w = first.weight.double()  # (P, 2d)
+    d = w.shape[1] // 2
+    a = torch.cat([w[:, :d].T, w[:, d:].T], 1)
+    hidden = [m for m in rest[:-1] if isinstance(m, torch.nn.Linear)]
+    p = w.shape[0]
+    wh = torch.stack([m.weight for m in hidden]) if hidden else w.new_zeros(0, p, p)
+    bh = torch.stack([m.bias for m in hidden]) if hidden else w.new_zeros(0, p)
+    return ConvBlocks(a, first.bias, wh, bh, rest[-1].weight, rest[-1].bias)
+
+
 @torch.no_grad()
 def pack(net, scene, dtype: np.dtype) -> PackedNetwork:
     """:class:`PackedNetwork` of a :class:`~.network.GraphDistNet` ``net`` (:func:`serves`)
@@ -87,18 +115,14 @@ def pack(net, scene, dtype: np.dtype) -> PackedNetwork:
     h = c.hidden
     ax, ah, b1, wh, bh, wl, bl = [], [], [], [], [], [], []
     for k, conv in enumerate(net.convs):
-        first, *rest = conv
-        w = first.weight.double()  # (H, 2d), z = (x ‖ h)
-        d = w.shape[1] // 2
-        a = torch.cat([w[:, :d].T, w[:, d:].T], 1)  # (d, 2H): [u v] = z a
-        ax.append(a[:2])
-        ah.append(a[2:] if k else a.new_zeros(h, 2 * h))
-        b1.append(first.bias)
-        hidden = [m for m in rest[:-1] if isinstance(m, torch.nn.Linear)]
-        wh.append(torch.stack([m.weight for m in hidden]))
-        bh.append(torch.stack([m.bias for m in hidden]))
-        wl.append(rest[-1].weight)
-        bl.append(3 * rest[-1].bias.double())
+        blocks = conv_blocks(conv)
+        ax.append(blocks.a[:2])
+        ah.append(blocks.a[2:] if k else blocks.a.new_zeros(h, 2 * h))
+        b1.append(blocks.b1)
+        wh.append(blocks.wh)
+        bh.append(blocks.bh)
+        wl.append(blocks.wl)
+        bl.append(3 * blocks.bl.double())  # the three edges of a ring node sum their biases
     head = [m for m in net.head if isinstance(m, torch.nn.Linear)]
     w0, hb0 = head[0].weight.double(), head[0].bias.double()
     n_r, n_o = len(scene.robot_ring) // 2, len(scene.obstacles)

@@ -38,6 +38,7 @@ import torch
 
 from ...graph3d import RobotGraph3D
 from ..graphdistnet import fused as planar_fused
+from ..graphdistnet.fused_net import conv_blocks
 from ..graphdistnet.layers import LEAKY_SLOPE
 from . import fused3d_kernels as _kernels
 from .config import GraphDistNet3DConfig
@@ -116,19 +117,14 @@ def pack(
     real = feats.mask[0]
     ax, ah, b1, wh, bh, wl, bl, v, score = [], [], [], [], [], [], [], [], []
     for k, conv in enumerate(net.convs):
-        first, *rest = conv
-        w = first.weight.double()  # (P, 2d), z = (x ‖ h)
-        d = w.shape[1] // 2
-        a = torch.cat([w[:, :d].T, w[:, d:].T], 1)  # (d, 2P): [u v] = z a
-        ax.append(a[:3])
-        ah.append(a[3:] if k else a.new_zeros(h, a.shape[1]))
-        b1.append(first.bias)
-        hidden = [m for m in rest[:-1] if isinstance(m, torch.nn.Linear)]
-        p = w.shape[0]
-        wh.append(torch.stack([m.weight for m in hidden]) if hidden else w.new_zeros(0, p, p))
-        bh.append(torch.stack([m.bias for m in hidden]) if hidden else w.new_zeros(0, p))
-        wl.append(rest[-1].weight)
-        bl.append(rest[-1].bias)
+        blocks = conv_blocks(conv)
+        ax.append(blocks.a[:3])
+        ah.append(blocks.a[3:] if k else blocks.a.new_zeros(h, blocks.a.shape[1]))
+        b1.append(blocks.b1)
+        wh.append(blocks.wh)
+        bh.append(blocks.bh)
+        wl.append(blocks.wl)
+        bl.append(blocks.bl)
         v.append(feats.v[k][0][real])
         s = feats.score[k]
         score.append(torch.zeros(int(real.sum())) if s is None else s[0][real])
