@@ -6,6 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import torch
+from model_checks import (
+    assert_deterministic_and_continuous,
+    assert_gradient_matches_central_differences,
+)
 
 from gdnplan.arm3d import Checker3D, Scene3D, load_robot3d, random_boxes
 from gdnplan.errors import InputError
@@ -48,15 +52,8 @@ def test_is_a_distance_model(model64):
 
 def test_gradient_matches_finite_differences(model64, robot, scene):
     qs = robot.random_configurations(4, np.random.default_rng(0))
-    d, g = model64.distance_and_grad(scene, qs)
-    np.testing.assert_allclose(d, model64.distance(scene, qs), atol=1e-12)
-    h = 1e-7  # d̂ is piecewise smooth (LeakyReLU): at 1e-6 one of these steps crosses a kink
-    for b, q in enumerate(qs):
-        fd = [
-            (model64.distance(scene, q + e) - model64.distance(scene, q - e))[0] / (2 * h)
-            for e in np.eye(robot.dof) * h
-        ]
-        np.testing.assert_allclose(g[b], fd, rtol=1e-4, atol=1e-8)
+    # h = 1e-7: at 1e-6 one of these steps crosses a LeakyReLU kink
+    assert_gradient_matches_central_differences(model64, scene, qs, h=1e-7)
 
 
 def test_deterministic_and_continuous_along_a_sweep(model64, robot, scene):
@@ -64,9 +61,8 @@ def test_deterministic_and_continuous_along_a_sweep(model64, robot, scene):
     q0 = robot.random_configurations(1, rng)[0]
     step = rng.uniform(-0.003, 0.003, robot.dof)  # ≤ 0.003 rad per joint
     path = q0 + np.arange(60)[:, None] * step
-    d = model64.distance(scene, path)
-    np.testing.assert_array_equal(d, model64.distance(scene, path))
-    assert np.abs(np.diff(d)).max() < 0.01  # m per ≤ 0.003 rad joint step (untrained weights)
+    # m per ≤ 0.003 rad joint step (untrained weights)
+    assert_deterministic_and_continuous(model64, scene, path, step_bound=0.01)
 
 
 def test_padded_obstacle_nodes_change_nothing(robot, scene):

@@ -7,6 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import torch
+from model_checks import (
+    assert_deterministic_and_continuous,
+    assert_gradient_matches_central_differences,
+)
 
 from gdnplan.arm3d import load_robot3d, random_boxes
 from gdnplan.errors import InputError
@@ -111,24 +115,14 @@ def test_soft_minimum_lies_between_the_minimum_and_the_mean():
 
 def test_gradient_matches_finite_differences(model64, robot, scene):
     qs = robot.random_configurations(4, np.random.default_rng(2))
-    d, g = model64.distance_and_grad(scene, qs)
-    np.testing.assert_allclose(d, model64.distance(scene, qs), atol=1e-12)
-    h = 1e-7  # d̂ is piecewise smooth (LeakyReLU): a larger step may cross a kink
-    for b, q in enumerate(qs):
-        fd = [
-            (model64.distance(scene, q + e) - model64.distance(scene, q - e))[0] / (2 * h)
-            for e in np.eye(robot.dof) * h
-        ]
-        np.testing.assert_allclose(g[b], fd, rtol=1e-4, atol=1e-8)
+    assert_gradient_matches_central_differences(model64, scene, qs, h=1e-7)
 
 
 def test_deterministic_and_continuous_along_a_sweep(model64, robot, scene):
     rng = np.random.default_rng(3)
     q0 = robot.random_configurations(1, rng)[0]
     path = q0 + np.arange(60)[:, None] * rng.uniform(-0.003, 0.003, robot.dof)
-    d = model64.distance(scene, path)
-    np.testing.assert_array_equal(d, model64.distance(scene, path))
-    assert np.abs(np.diff(d)).max() < 0.01  # m per ≤ 0.003 rad joint step
+    assert_deterministic_and_continuous(model64, scene, path, step_bound=0.01)
 
 
 def test_config_round_trip_and_bad_temperature():
