@@ -16,7 +16,7 @@ import torch
 
 import gdnplan as gp
 from gdnplan.assets import default_weights
-from gdnplan.models.graphdistnet import fused
+from gdnplan.models.graphdistnet import fused, fused_net
 from gdnplan.models.graphdistnet import fused_net_backward as bw
 from gdnplan.models.graphdistnet import fused_net_kernels as fw
 
@@ -27,7 +27,7 @@ def profile(packed, x, seconds) -> None:
     bsz, n_r, _ = x.shape
     n = net.ring.shape[1]
     layers, h = net.att.shape
-    tile = max(1, fused.TILE_ROWS // (3 * n))
+    tile = max(1, fused_net.TILE_ROWS // (3 * n))
     dt = x.dtype
     hidden, width = net.wht.shape[1], net.h0t.shape[0]
     st = fw.State(
@@ -101,7 +101,7 @@ def main() -> None:
     x = np.ascontiguousarray((nodes - packed.origin) / packed.scale, np.float32)
     d = np.empty(len(x), np.float32)
     g = np.zeros(x.shape, np.float32)
-    tile = max(1, fused.TILE_ROWS // (3 * packed.net.ring.shape[1]))
+    tile = max(1, fused_net.TILE_ROWS // (3 * packed.net.ring.shape[1]))
     whole = float("inf")
     best: dict[str, float] | None = None
     with fused._serial_blas():
