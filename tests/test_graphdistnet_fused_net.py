@@ -70,7 +70,7 @@ def test_whole_pass_equals_reference_in_float64(weights):
     rows = packed.net.ring.shape[1]  # per configuration: robot nodes (+ obstacle nodes, two-way)
     two_way = whole.config.two_way
     assert rows == whole._graphs(scene).robot.n_nodes + two_way * len(packed.net.xo)
-    tile = fused_kernel.TILE_ROWS // (3 * rows)
+    tile = fused_net.TILE_ROWS // (3 * rows)
     q = configurations(scene, n=max(64, tile + 8))
     assert len(q) > tile  # more than one tile
     d, g = whole.distance_and_grad(scene, q)

@@ -46,7 +46,9 @@ from . import fused_net_kernels as _kernels
 from .config import GraphDistNetConfig
 from .layers import LEAKY_SLOPE
 
-__all__ = ["PackedNetwork", "pack", "run", "serves"]
+__all__ = ["TILE_ROWS", "PackedNetwork", "pack", "run", "serves"]
+
+TILE_ROWS = 2048  # edge rows per tile, 3 n per configuration (docs/decisions.md, s7-kernel)
 
 
 def serves(config: GraphDistNetConfig) -> bool:
@@ -181,7 +183,7 @@ def run(
     b, n_r, _ = x.shape
     d = np.empty(b, dtype)
     g = np.zeros((b, n_r, 2) if grad else (0, n_r, 2), dtype)
-    tile = max(1, fused.TILE_ROWS // (3 * weights.net.ring.shape[1]))
+    tile = max(1, TILE_ROWS // (3 * weights.net.ring.shape[1]))
     tiles = -(-b // tile)
     edges = [tile * (tiles * i // threads) for i in range(threads)] + [b]
     parts = [slice(lo, hi) for lo, hi in itertools.pairwise(dict.fromkeys(edges)) if hi > lo]

@@ -1,0 +1,125 @@
+"""Thread CPU seconds per stage of the whole-network pass (models/graphdistnet/fused_net.py):
+the compiled stages called one by one from Python, tile by tile, for n random configurations
+of one scene (float32, one thread).
+
+    python benchmarks/fused_profile.py [--env e] [--n 5000] [--repeats 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections import defaultdict
+
+import numpy as np
+import torch
+
+import gdnplan as gp
+from gdnplan.assets import default_weights
+from gdnplan.models.graphdistnet import fused, fused_net
+from gdnplan.models.graphdistnet import fused_net_backward as bw
+from gdnplan.models.graphdistnet import fused_net_kernels as fw
+
+
+def profile(packed, x, seconds) -> None:
+    """Add each stage's thread CPU seconds over the batch x (B, N_r, 2) to ``seconds``."""
+    net, cand = packed.net, packed.candidates
+    bsz, n_r, _ = x.shape
+    n = net.ring.shape[1]
+    layers, h = net.att.shape
+    tile = max(1, fused_net.TILE_ROWS // (3 * n))
+    dt = x.dtype
+    hidden, width = net.wht.shape[1], net.h0t.shape[0]
+    st = fw.State(
+        np.empty((tile, n, 2), dt),
+        np.empty((tile, n, cand), np.int64),
+        np.empty((tile, n, cand), dt),
+        np.empty((tile, n, cand), dt),
+        np.empty((layers, tile, n, cand), dt),
+        np.empty((layers, tile * n if n > n_r else 0, h), dt),
+        np.empty((layers, tile * n, h), dt),
+        np.empty((layers, hidden + 1, 3 * tile * n, h), np.bool_),
+        np.empty((layers, tile, n), dt),
+        np.empty((layers, tile, n), dt),
+        np.empty((layers, tile, width), np.bool_),
+        np.empty((tile, width), np.int64),
+        np.empty((net.hw.shape[0] + 1, tile, net.wlast.shape[0]), np.bool_),
+    )
+    two_way = n > n_r
+    g_out = np.zeros((bsz, n_r, 2), dt)
+
+    def timed(name, f, *args):
+        t0 = time.thread_time()
+        out = f(*args)
+        seconds[name] += time.thread_time() - t0
+        return out
+
+    for b0 in range(0, bsz, tile):
+        xt = x[b0 : b0 + tile]
+        t_n = xt.shape[0]
+        timed("candidates", fw._candidates, xt, net, st)
+        pooled = np.empty((t_n, width), dt)
+        for k in range(layers):
+            timed("soft weights", fw._soft_weights, net, st, k, t_n, two_way)
+            uv, cc = timed("node terms", fw._node_terms, net, st, k, t_n, two_way)
+            timed("edge MLP", fw._edge_mlp, net, st, k, t_n, uv, cc)
+            timed("readout", fw._readout, net, st, k, t_n, n_r, pooled)
+        rows = t_n * n
+        g = g_out[b0 : b0 + tile]
+        dy = timed("head (bw)", bw._head_backward, net, st, t_n)
+        dh = np.zeros((rows, h), dt)
+        dlphi = np.zeros((t_n, n, cand), dt)
+        dnear = np.zeros((t_n, n, cand), dt)
+        dscore = np.zeros(rows, dt)
+        for k in range(layers - 1, -1, -1):
+            timed("readout (bw)", bw._readout_backward, net, st, k, t_n, n_r, dy, dh)
+            duv, dc = timed("edge MLP (bw)", bw._edge_backward, net, st, k, t_n, dh)
+            dscore[:] = 0
+            args = (net, st, k, t_n, two_way, duv, dc, dlphi, dnear, dscore)
+            timed("cross (bw)", bw._cross_backward, *args)
+            if k:
+                t0 = time.thread_time()
+                dh = np.dot(duv, net.aht[k])
+                seconds["dz (bw, numpy)"] += time.thread_time() - t0
+        timed("candidates (bw)", bw._candidates_backward, net, st, t_n, n_r, dlphi, dnear, g)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--env", default="e")
+    p.add_argument("--n", type=int, default=5000)
+    p.add_argument("--repeats", type=int, default=3)
+    args = p.parse_args()
+    torch.set_num_threads(1)
+    scene = gp.make_scene(args.env, seed=0)
+    q = scene.robot.sample(args.n, seed=0)
+    model = gp.load_model(default_weights(scene))
+    model.fused = True
+    graphs = model._graphs(scene)
+    packed = graphs.whole
+    nodes, _ = graphs.robot.kinematics(q)
+    x = np.ascontiguousarray((nodes - packed.origin) / packed.scale, np.float32)
+    d = np.empty(len(x), np.float32)
+    g = np.zeros(x.shape, np.float32)
+    tile = max(1, fused_net.TILE_ROWS // (3 * packed.net.ring.shape[1]))
+    whole = float("inf")
+    best: dict[str, float] | None = None
+    with fused._serial_blas():
+        for _ in range(args.repeats + 1):
+            g[:] = 0
+            t0 = time.thread_time()
+            fw.network(x, packed.net, packed.candidates, d, g, tile)
+            whole = min(whole, time.thread_time() - t0)
+            seconds: dict[str, float] = defaultdict(float)
+            profile(packed, x, seconds)
+            if best is None or sum(seconds.values()) < sum(best.values()):
+                best = seconds
+    print(f"env {args.env}, n {args.n}, n rows {packed.net.ring.shape[1]}, tile {tile}")
+    print(f"whole pass (d + grad, one call): {whole:.3f} s thread CPU")
+    for name, s in best.items():
+        print(f"  {name:18s} {s:.3f} s")
+    print(f"  {'sum of stages':18s} {sum(best.values()):.3f} s")
+
+
+if __name__ == "__main__":
+    main()
