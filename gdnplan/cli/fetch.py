@@ -33,7 +33,7 @@ def fetch_command(
     view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
     three_d: bool = typer.Option(
-        False, "--3d", help="The 3-D fetch: the full six-joint UR5e, exact coal distances."
+        False, "--3d", help="The 3-D fetch: the full six-joint UR5e, coal-certified stages."
     ),
     placement: str = typer.Option(
         None, help="--3d: the storage's front-face centre and yaw 'x,y,yaw' (m, m, rad)."
