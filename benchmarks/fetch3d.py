@@ -7,8 +7,10 @@ six stages run with coal distances and the planner's defaults (:func:`run_fetch3
 counts when its coal certificate holds (planned stages: d > 0.01 m on the whole continuous
 path; grasp: the stick rests on its shelf; lift: certified from 2 mm up). The planned stages'
 paths are re-certified here with :func:`certify_path3d`, independently of the planner.
+``--weights W``: the planned stages with learned constraints, GraphDistNet-3D weights trained
+on ``ur5e_storage`` (refused before any planning otherwise); the certificates stay coal's.
 
-    python benchmarks/fetch3d.py --threads 1 [--seeds 1-8]
+    python benchmarks/fetch3d.py --threads 1 [--seeds 1-8] [--weights W]
 """
 
 from __future__ import annotations
@@ -34,8 +36,16 @@ def seeds_arg(text: str) -> list[int]:
 def main() -> None:
     p = common.parser("fetch3d", __doc__)
     p.add_argument("--seeds", type=seeds_arg, default=list(range(1, 9)), help="fetch seeds")
+    p.add_argument("--weights", default=None, help="GraphDistNet-3D weights (ur5e_storage)")
     args = common.parse(p)
-    report = common.Report(args, "3-D fetch: 8 random storage placements", __doc__.split("\n\n")[1])
+    collision = "coal"
+    title = "3-D fetch: 8 random storage placements"
+    if args.weights is not None:
+        from gdnplan.cli.fetch3d import learned_fetch_model
+
+        collision = learned_fetch_model(args.weights)
+        title += f", learned constraints ({args.weights})"
+    report = common.Report(args, title, __doc__.split("\n\n")[1])
     rows = report.table(
         "seed",
         "placement x, y (m), yaw (rad)",
@@ -50,7 +60,7 @@ def main() -> None:
         t0 = time.perf_counter()
         fetch = fetch3d(seed)
         setup = time.perf_counter() - t0
-        stages = run_fetch3d(fetch=fetch)
+        stages = run_fetch3d(fetch=fetch, collision=collision)
         again = all(certify_path3d(s.scene, s.q, margin=MARGIN).ok for s in stages if s.planned)
         ok = all(s.success for s in stages) and again
         certified += ok

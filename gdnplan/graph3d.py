@@ -39,6 +39,7 @@ from .errors import InputError
 RIM = 8  # points per cylinder rim (docs/decisions.md#graphdistnet-3d-robot-graph-nodes)
 HULL_POINTS = 24  # most vertices kept of a mesh hull
 COPLANAR = 1e-10  # facets with 1 − n₁·n₂ below this (unit normals) are one face
+FACE_SPACING = 0.2  # m: the largest training box side; larger box sides get grid nodes
 
 
 # -------------------------------------------------------------------- shapes → points
@@ -279,14 +280,50 @@ def union(graphs: list[ObstacleGraph3D]) -> ObstacleGraph3D:
     return ObstacleGraph3D(np.concatenate(nodes), np.concatenate(nbr), np.concatenate(mask))
 
 
+def box_grid(half: np.ndarray, spacing: float = FACE_SPACING) -> tuple[np.ndarray, np.ndarray]:
+    """Surface nodes (k, 3) and edges (E, 2) of a box of half sides ``half`` (3,) (m) in its
+    own frame, for a box with a side longer than ``spacing``.
+
+    Side a is cut into n_a = ⌈2h_a / spacing⌉ equal steps; the nodes are the points of the
+    lattice x_a = −h_a + 2h_a i / n_a (i = 0 … n_a) on the surface (some coordinate at ±h_a),
+    the edges join lattice neighbours (one step along one axis) that are both on the surface:
+    every face is a grid of spacing ≤ ``spacing`` and the box's 12 edges are paths of it. A box
+    with every side ≤ ``spacing`` has n = (1, 1, 1): its 8 corners and 12 edges (the caller
+    keeps :func:`shape_points`' order for those, so their graphs do not change)."""
+    n = np.maximum(1, np.ceil(2 * half / spacing - 1e-9)).astype(int)
+    axes = [np.linspace(-h, h, k + 1) for h, k in zip(half, n, strict=True)]
+    idx = np.stack(np.meshgrid(*(np.arange(k + 1) for k in n), indexing="ij"), -1).reshape(-1, 3)
+    on = np.any((idx == 0) | (idx == n), axis=1)
+    number = -np.ones(len(idx), int)
+    number[on] = np.arange(on.sum())
+    grid = number.reshape(*(n + 1))
+    edges = []
+    for a in range(3):
+        lo = [slice(None)] * 3
+        hi = [slice(None)] * 3
+        lo[a], hi[a] = slice(0, -1), slice(1, None)
+        u, v = grid[tuple(lo)].ravel(), grid[tuple(hi)].ravel()
+        keep = (u >= 0) & (v >= 0)
+        edges.append(np.c_[u[keep], v[keep]])
+    pts = np.array([[axes[a][i[a]] for a in range(3)] for i in idx[on]])
+    return pts, np.concatenate(edges)
+
+
 def obstacle_graph3d(obstacle: Obstacle3D, rim: int = RIM, k: int = 6) -> ObstacleGraph3D:
     """The graph of one obstacle posed in the world: a convex shape's points
-    (:func:`shape_points`) with its polytope's edges; a coal octree (a sensor's point cloud as
+    (:func:`shape_points`) with its polytope's edges, but a box with a side longer than
+    FACE_SPACING gets grid nodes over its faces (:func:`box_grid`: its corners alone would
+    leave the middle of a table or a wall unseen); a coal octree (a sensor's point cloud as
     coal sees it) as the k-nearest-neighbour graph of its occupied voxels' centres."""
     rot, trans = np.asarray(obstacle.pose.getRotation()), np.asarray(obstacle.pose.getTranslation())
     if isinstance(obstacle.shape, coal.OcTree):
         centres = np.asarray(obstacle.shape.toBoxes(), dtype=float).reshape(-1, 6)[:, :3]
         return point_cloud_graph(centres @ rot.T + trans, k)
+    if isinstance(obstacle.shape, coal.Box):
+        half = np.asarray(obstacle.shape.halfSide)
+        if 2 * half.max() > FACE_SPACING + 1e-9:
+            pts, edges = box_grid(half)
+            return graph_of_points(pts @ rot.T + trans, edges)
     pts = shape_points(obstacle.shape, rim)
     return graph_of_points(pts @ rot.T + trans, hull_edges(pts))
 
@@ -317,11 +354,13 @@ def box_graphs(centers: np.ndarray, sizes: np.ndarray) -> ObstacleGraph3D:
 
 
 __all__ = [
+    "FACE_SPACING",
     "HULL_POINTS",
     "RIM",
     "ObstacleGraph3D",
     "RobotGraph3D",
     "box_graphs",
+    "box_grid",
     "farthest_points",
     "fibonacci_sphere",
     "graph_of_points",

@@ -24,6 +24,8 @@ BAD = [
     ["fetch", "--3d", "--animate", "{tmp}/x.gif"],
     ["fetch", "--3d", "--collision", "graphdistnet3d"],
     ["fetch", "--3d", "--collision", "graphdistnet"],  # was silently coal
+    ["fetch", "--3d", "--collision", "graphdistnet", "--weights", "ur5e_boxes3d_preliminary"],
+    ["fetch", "--3d", "--weights", "ur5e_boxes3d_preliminary"],  # weights without graphdistnet
     ["fetch", "--3d", "--write-problems", "{tmp}/a_file"],
 ]
 

@@ -149,10 +149,10 @@ def test_box_graphs_equal_the_scene_graph_of_the_same_boxes(ur5e):
 
 def test_rotated_box_nodes_are_its_corners(ur5e):
     rot = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
-    o = box_obstacle((0.1, 0.2, 0.3), (0.5, 0.0, 0.2), rot)
+    o = box_obstacle((0.1, 0.2, 0.15), (0.5, 0.0, 0.2), rot)  # sides ≤ FACE_SPACING: corners
     g = scene_graph3d(type("S", (), {"obstacles": (o,)})())
     local = (g.nodes - [0.5, 0.0, 0.2]) @ rot  # back in the box frame
-    np.testing.assert_allclose(np.sort(np.abs(local), 0)[0], [0.05, 0.1, 0.15], atol=1e-12)
+    np.testing.assert_allclose(np.sort(np.abs(local), 0)[0], [0.05, 0.1, 0.075], atol=1e-12)
 
 
 def test_point_cloud_graph_and_bad_clouds():

@@ -39,6 +39,7 @@ import numpy as np
 from ..errors import InputError
 from ..trajopt import PlanConfig, Problem, plan
 from ..trajopt.config import SeedConfig
+from ..trajopt.planner import checked
 from ..ur5e.layout import LIFT
 from .ccd3d import certify_path3d
 from .distance3d import checker3d
@@ -142,11 +143,13 @@ def stage_problems(fetch: Fetch3D, name: str, margin: float = MARGIN) -> list[Pr
     ]
 
 
-def _planned(fetch: Fetch3D, name: str, margin: float) -> Stage3D:
-    """Plan every piece of a stage; the stage succeeds when every piece is certified."""
+def _planned(fetch: Fetch3D, name: str, margin: float, collision="coal") -> Stage3D:
+    """Plan every piece of a stage with the constraints of ``collision`` ("coal" or a
+    DistanceModel, checked against the stage's scene); the stage succeeds when every piece is
+    certified (by coal)."""
     t0 = time.perf_counter()
     problems = stage_problems(fetch, name, margin)
-    runs = [plan(p, collision="coal") for p in problems]
+    runs = [plan(p, collision=collision) for p in problems]
     ok = all(r.success for r in runs)
     q = np.vstack([runs[0].q, *(r.q[1:] for r in runs[1:])])
     lower = min(r.min_distance for r in runs) if ok else -np.inf
@@ -186,14 +189,21 @@ def run_fetch3d(
     margin: float = MARGIN,
     stages: tuple[str, ...] = STAGES,
     fetch: Fetch3D | None = None,
+    collision="coal",
 ) -> list[Stage3D]:
     """Run the 3-D fetch (or the listed ``stages``, in order) on fetch ``seed`` (or a given
     :class:`Fetch3D`). Every stage runs even when an earlier one failed (each starts from its
-    own configuration); each finished stage is logged (``gdnplan.arm3d.fetch3d``, INFO)."""
+    own configuration); each finished stage is logged (``gdnplan.arm3d.fetch3d``, INFO).
+    ``collision``: the planned stages' constraints, "coal" or a DistanceModel (e.g.
+    GraphDistNet-3D weights trained on ``ur5e_storage``); it must accept both fetch scenes
+    (``check_scene``), checked before any stage is planned."""
     for name in stages:
         if name not in STAGES:
             raise InputError(f"stages: unknown stage {name!r}; choose from {STAGES}")
     fetch = fetch if fetch is not None else fetch3d(seed)
+    if not isinstance(collision, str):
+        for scene in fetch.scenes.values():
+            checked(collision, scene)
     out = []
     for name in stages:
         if name == "grasp":
@@ -201,7 +211,7 @@ def run_fetch3d(
         elif name == "lift":
             out.append(_lift(fetch))
         else:
-            out.append(_planned(fetch, name, margin))
+            out.append(_planned(fetch, name, margin, collision))
         done = out[-1]
         verdict = "certified" if done.success else "FAILED"
         log.info("fetch3d stage %s: %s, %.2f s", name, verdict, done.solve_time)

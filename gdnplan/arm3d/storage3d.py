@@ -34,6 +34,8 @@ from ..ur5e.layout import LIFT
 from .scene3d import Obstacle3D, box_obstacle
 
 TABLE = ((0.15, 1.1), (-0.8, 0.8), 0.05)  # x range, y range, thickness (m): clear of the base
+STICK_LENGTH = (0.15, 0.30)  # m: range of random_storage's stick length
+STICK_WIDTH = (0.02, 0.04)  # m: range of random_storage's stick width
 PLACEMENT_RADIUS = (0.55, 0.75)  # m: distance of the front-face centre from the base axis
 PLACEMENT_BEARING = np.pi / 4  # rad: |bearing| of the front-face centre from the x axis
 PLACEMENT_YAW = np.pi / 9  # rad: |yaw − bearing|, the entrance turned at most this from the base
@@ -181,7 +183,7 @@ def random_storage(rng: np.random.Generator) -> Storage3D:
     lifted to 3-D: the entrance clears the gripper body (BODY_WIDTH × BODY_DEPTH across the
     tool axis) by 0.03–0.05 m on each side, and the lift above it."""
     wall, inset, overhang = 0.02, rng.uniform(0.02, 0.06), 0.07
-    length, width = rng.uniform(0.15, 0.30), rng.uniform(0.02, 0.04)
+    length, width = rng.uniform(*STICK_LENGTH), rng.uniform(*STICK_WIDTH)
     floor = wall + rng.uniform(0.0, 0.25)
     shelf = floor + rng.uniform(0.07, 0.12)
     axis = shelf + width / 2

@@ -23,8 +23,8 @@ def fetch_command(
     seed: int = typer.Option(0, min=0, help="Fetch layout: 0 canonical, others random storages."),
     collision: str = typer.Option(
         None,
-        help="Collision model: graphdistnet or coal; default graphdistnet (planar), coal (--3d: "
-        "the only one it takes).",
+        help="Collision model: graphdistnet or coal; default graphdistnet (planar), coal (--3d; "
+        "graphdistnet there needs --weights trained on ur5e_storage).",
     ),
     weights: str = typer.Option(None, help=WEIGHTS_HELP),
     animate: Path = typer.Option(None, help="Write an animated GIF of all stages."),
@@ -33,7 +33,7 @@ def fetch_command(
     view3d: bool = typer.Option(False, "--view3d", help="3-D browser view (needs meshcat)."),
     quiet: bool = typer.Option(False, "--quiet", "-q", help=QUIET_HELP),
     three_d: bool = typer.Option(
-        False, "--3d", help="The 3-D fetch: the full six-joint UR5e, exact coal distances."
+        False, "--3d", help="The 3-D fetch: the full six-joint UR5e, coal-certified stages."
     ),
     placement: str = typer.Option(
         None, help="--3d: the storage's front-face centre and yaw 'x,y,yaw' (m, m, rad)."
@@ -51,21 +51,23 @@ def fetch_command(
 
     show_progress(not quiet)
     if three_d:
-        planar_only = {"--animate": animate, "--view3d": view3d, "--weights": weights}
-        if collision == "graphdistnet":  # asked for by name: say why not, never plan with coal
-            raise InputError(
-                "--collision graphdistnet: the 3-D fetch plans with coal only; no GraphDistNet-3D "
-                "weights are trained on the storage and the fetch's gripper and held stick (the "
-                "shipped ur5e_boxes3d_preliminary refuse them); use --collision coal"
-            )
-        planar_only["--collision"] = collision not in (None, "coal") and collision
+        planar_only = {"--animate": animate, "--view3d": view3d}
+        if collision not in (None, "coal", "graphdistnet"):
+            planar_only["--collision"] = collision
+        if weights is not None and collision != "graphdistnet":
+            planar_only["--weights"] = weights
         for flag, value in planar_only.items():
             if value:
-                raise InputError(f"{flag}: the 3-D fetch does not take it (coal distances only)")
+                raise InputError(
+                    f"{flag}: the 3-D fetch does not take it (coal, or --collision graphdistnet "
+                    "--weights W trained on ur5e_storage)"
+                )
         from .fetch3d import run_fetch3d_command
 
         set_threads(threads)
-        if not run_fetch3d_command(seed, placement, json_output, write_problems):
+        if not run_fetch3d_command(
+            seed, placement, json_output, write_problems, collision or "coal", weights
+        ):
             raise typer.Exit(1)
         return
     for flag, value in (("--placement", placement), ("--write-problems", write_problems)):

@@ -24,17 +24,45 @@ def parse_placement(text: str | None):
     return check_placement(*values)
 
 
+NOT_STORAGE = (
+    "--collision graphdistnet: the 3-D fetch needs GraphDistNet-3D weights trained on the storage "
+    "and the fetch's gripper and held stick (env ur5e_storage; the shipped "
+    "ur5e_boxes3d_preliminary refuse them); give such --weights or use --collision coal"
+)
+
+
+def learned_fetch_model(weights: str | None):
+    """The GraphDistNet-3D model of ``weights`` for the fetch: InputError (:data:`NOT_STORAGE`)
+    without weights or for weights whose card is not of ``ur5e_storage``."""
+    if weights is None:
+        raise InputError(NOT_STORAGE)
+    from ..models import load_model
+
+    model = load_model(weights)
+    env = getattr(model, "card", {}).get("env")
+    if env != "ur5e_storage":
+        raise InputError(f"{NOT_STORAGE} (these weights: env {env!r})")
+    return model
+
+
 def run_fetch3d_command(
     seed: int,
     placement: str | None,
     json_output: bool,
     write_problems: Path | None,
+    collision: str = "coal",
+    weights: str | None = None,
 ) -> bool:
-    """Run the 3-D fetch and print it; True when every stage is certified."""
+    """Run the 3-D fetch and print it; True when every stage is certified. ``collision``
+    "graphdistnet" plans with GraphDistNet-3D ``weights``, refused (one InputError, before
+    any planning) unless the weights know the storage and both fetch scenes."""
     from ..arm3d.fetch3d import run_fetch3d
     from ..arm3d.fetch3d_scene import fetch3d
 
     where = parse_placement(placement)
+    model = "coal"
+    if collision == "graphdistnet":
+        model = learned_fetch_model(weights)
     if write_problems is not None:
         from ..files import check_output_dir
 
@@ -45,14 +73,19 @@ def run_fetch3d_command(
         from ..arm3d.fetch3d_files import write_stage_problems
 
         written = write_stage_problems(fetch, write_problems)
-    stages = run_fetch3d(fetch=fetch)
+    try:
+        stages = run_fetch3d(fetch=fetch, collision=model)
+    except InputError as e:
+        if collision != "graphdistnet":
+            raise
+        raise InputError(f"{NOT_STORAGE} ({e})") from e
     ok = all(s.success for s in stages)
     p = fetch.placement
     if json_output:
         summary = {
             "seed": seed,
             "placement": {"x": p.x, "y": p.y, "yaw": p.yaw},
-            "collision": "coal",
+            "collision": collision,
             "success": ok,
             "stages": [s.summary() for s in stages],
             "problems": [str(w) for w in written],

@@ -20,7 +20,9 @@ from .common import set_threads
 
 @app.command("generate")
 def generate_command(
-    env: str = typer.Option(..., help="Environment: a-e, ur5e, or ur5e_boxes (3-D)."),
+    env: str = typer.Option(
+        ..., help="Environment: a-e, ur5e, or ur5e_boxes, ur5e_cloud, ur5e_storage (3-D)."
+    ),
     split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
     n: int = typer.Option(None, min=1, help="Samples (default: the paper's 50 000 / 5 000)."),
     seed: int = typer.Option(None, min=0, help="Override the split's seed."),

@@ -19,6 +19,10 @@ the union of balls of radius ``POINT_RADIUS`` around its points (coal spheres), 
 labels and a certificate use (not coal's octree, whose normals have the opposite sign
 convention in Checker3D's gradient).
 
+Environment ``ur5e_storage``: the fetch's table and a random storage at a random placement,
+the UR5e with its fingers open (the stick an obstacle) or holding the stick, one variant per
+scene (:mod:`gdnplan.data.samples_storage3d`, which also names its shard arrays).
+
 Labels: f(q) = the robot–obstacle signed distance (m), the minimum of coal's signed distances
 over the (link shape, box) pairs — self-collision is not learned (GraphDistNet-3D's model adds
 the exact self distance beside it) — and its exact gradient ∂f/∂q (m/rad)
@@ -54,8 +58,9 @@ from ..arm3d import (
     sphere_obstacle,
 )
 from ..errors import InputError, UnknownNameError
+from .samples_storage3d import storage_scenes
 
-ENVS3D = {"ur5e_boxes": "ur5e", "ur5e_cloud": "ur5e"}  # environment -> robot
+ENVS3D = {"ur5e_boxes": "ur5e", "ur5e_cloud": "ur5e", "ur5e_storage": "ur5e"}  # env -> robot
 N_BOXES = 20
 CLOUD_BOXES = 10  # boxes whose surfaces a cloud samples
 CLOUD_POINTS = 400  # points per cloud
@@ -150,7 +155,9 @@ def make_shard3d(env: str, seed: int, start: int, n: int, near: float = 0.0) -> 
     n_scenes = -(-n // SCENE_SAMPLES)
     seeds = seed * 10**8 + first + np.arange(n_scenes, dtype=np.int64)
     cloud = env == "ur5e_cloud"
-    if cloud:
+    if env == "ur5e_storage":
+        geometry, scenes = storage_scenes(seeds)
+    elif cloud:
         geometry = {"points": np.array([scene_cloud(env, s) for s in seeds])}
         scenes = [cloud_scene(labeller, p) for p in geometry["points"]]
     else:
@@ -163,7 +170,7 @@ def make_shard3d(env: str, seed: int, start: int, n: int, near: float = 0.0) -> 
     scene = np.arange(n, dtype=np.int32) // SCENE_SAMPLES
     for s in range(n_scenes):
         rows = np.flatnonzero(scene == s)
-        checker = Checker3D(scenes[s])
+        checker = Checker3D(scenes[s])  # the robot of the scene: same joints and limits
         qs = robot.random_configurations(len(rows), rng)
         is_near = rng.random(len(rows)) < near if near > 0 else np.zeros(len(rows), bool)
         if is_near.any():

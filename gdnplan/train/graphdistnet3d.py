@@ -5,7 +5,9 @@ memory at a time. Epoch e visits the shards in a permutation seeded by (seed, e)
 each shard in a permutation seeded by (seed, e, shard), in batches of ``batch`` rows (a shard's
 last, shorter batch included). A batch's robot nodes and node Jacobians come from Pinocchio
 (:meth:`~gdnplan.graph3d.RobotGraph3D.positions_and_jacobians`); the obstacle features are
-computed once per scene of the batch (one-way cross edges) and handed to its rows.
+computed once per scene of the batch (one-way cross edges) and handed to its rows. A
+``ur5e_storage`` shard's rows have a robot graph each (fingers open or holding the stick:
+:mod:`gdnplan.train.batch_storage3d`); the exported card names the validation split's env.
 
 Loss: :mod:`gdnplan.train.loss` (normalised squared error, contact weight, gradient cosine).
 After every ``validate_every`` steps the network is scored on the first ``n_val`` samples of
@@ -52,6 +54,7 @@ from ..models.graphdistnet3d import (
     robot_tensors,
 )
 from ..models.weights import read_card, write_weights
+from .batch_storage3d import StorageBatch3D
 from .checkpoint import load_checkpoint, save_checkpoint
 from .loss import GraphDistNetLoss, distance_loss, gradient_loss
 from .report import git_sha, metrics
@@ -137,6 +140,19 @@ class Batch3D:
         return net(self.nodes, nbr, nbr_mask, feats)
 
 
+def make_batch(graph, shard: dict, rows: np.ndarray, rim: int):
+    """The batch of some rows of a shard: :class:`Batch3D` with the robot ``graph``, or for a
+    ``ur5e_storage`` shard (robot variants) a :class:`StorageBatch3D` (a robot graph per row)."""
+    if "variant" in shard:
+        return StorageBatch3D(rim, shard, rows)
+    return Batch3D(graph, shard, rows)
+
+
+def split_env(folder: Path | str) -> str:
+    """The environment of a split folder (its first shard's ``env``)."""
+    return str(read_shard(shard_files(folder)[0])["env"])
+
+
 def evaluate3d(net: GraphDistNet3D, folder: Path | str, n: int | None = None, chunk: int = 200):
     """Metrics (:func:`gdnplan.train.report.metrics`, margin 0) of ``net`` on the first n samples
     of a split folder, against its coal labels, with ∂d̂/∂q through the node Jacobians."""
@@ -148,7 +164,7 @@ def evaluate3d(net: GraphDistNet3D, folder: Path | str, n: int | None = None, ch
         shard = read_shard(f)
         m = len(shard["d"]) if n is None else min(len(shard["d"]), n - taken)
         for s in range(0, m, chunk):
-            b = Batch3D(graph, shard, np.arange(s, min(s + chunk, m)))
+            b = make_batch(graph, shard, np.arange(s, min(s + chunk, m)), net.config.rim)
             dh, gh = b.run(net, graph, False)
             d_hat.append(dh.detach().double().numpy())
             g_hat.append(gh.detach().double().numpy())
@@ -239,7 +255,7 @@ def train3d(
         for step, shard, rows in batches(
             files, config.batch, config.seed, state["epoch"], state["step"]
         ):
-            b = Batch3D(graph, shard, rows)
+            b = make_batch(graph, shard, rows, network.rim)
             if config.grad_weight > 0:
                 d_hat, g_hat = b.run(net, graph, True)
                 loss = distance_loss(d_hat, b.d, loss_cfg, network.scale)
@@ -309,7 +325,7 @@ def export_weights(
     test = evaluate3d(net, val_dir, n_test)
     out_card = {
         "model": "graphdistnet3d",
-        "env": "ur5e_boxes",
+        "env": split_env(val_dir),
         "robot": "ur5e",
         "training": {k: state[k] for k in ("epoch", "step", "samples", "seconds", "best")},
         "settings": card["settings"],

@@ -23,6 +23,10 @@ model that answers ``distance`` must not answer wrongly.) The rules, from the ca
   defaults of :func:`gdnplan.arm3d.random_boxes` (within :data:`GEOMETRY_TOL`). Any other
   shape — sphere, cylinder, capsule, mesh, a point cloud's octree — is refused. A card naming
   an environment not in :data:`TRAINED` is refused (its training scenes are unknown here).
+  For ``ur5e_storage`` (:mod:`gdnplan.data.samples_storage3d`): boxes turned about the
+  vertical only (the table, the storage's walls, the stick), none longer than the table, and
+  the robot may hold a box stick within :func:`~gdnplan.arm3d.storage3d.random_storage`'s
+  ranges (its nodes are then left out of the robot comparison).
 * A card without ``"env"`` or ``"robot"`` (a network built in code, not trained weights)
   makes no claim and is not checked on that point; every scene needs an obstacle.
 """
@@ -35,7 +39,9 @@ import coal
 import numpy as np
 
 from ...arm3d import Obstacle3D, Scene3D, load_robot3d
+from ...arm3d.held import HELD_LINK
 from ...arm3d.scene3d import BASE_CLEARANCE, BOX_SIZE
+from ...arm3d.storage3d import STICK_LENGTH, STICK_WIDTH, TABLE
 from ...errors import InputError
 from ...graph3d import robot_graph3d
 
@@ -77,7 +83,62 @@ class Boxes:
         return None
 
 
-TRAINED = {"ur5e_boxes": Boxes(BOX_SIZE, BASE_CLEARANCE)}  # environment -> its obstacles
+@dataclass(frozen=True)
+class StorageBoxes:
+    """Training obstacles of ``ur5e_storage``: the table, a storage's walls and the stick —
+    boxes turned about the vertical axis only, no side longer than ``max_side`` (m), centres
+    at least ``base_clearance`` (m) from the base's vertical axis; and the robot may hold a
+    box stick (the fetch's) of length within ``stick_length`` and width ``stick_width`` (m)."""
+
+    max_side: float
+    base_clearance: float
+    stick_length: tuple[float, float]
+    stick_width: tuple[float, float]
+
+    def describe(self) -> str:
+        return (
+            f"boxes turned about the vertical only, sides ≤ {self.max_side:g} m, centres ≥ "
+            f"{self.base_clearance:g} m from the base axis (a table and storages)"
+        )
+
+    def misfit(self, obstacle: Obstacle3D) -> str | None:
+        """Why ``obstacle`` is outside the training obstacles (None: inside)."""
+        shape = obstacle.shape
+        if not isinstance(shape, coal.Box):
+            return f"is a {shape_kind(shape)}"
+        rot = np.asarray(obstacle.pose.getRotation())
+        if not np.allclose(np.abs(rot[2]), [0.0, 0.0, 1.0], atol=1e-6):
+            return "is a box tilted off the vertical"
+        sides = 2.0 * np.asarray(shape.halfSide)
+        if sides.max() > self.max_side + GEOMETRY_TOL:
+            return f"is a box of sides {' × '.join(f'{s:.3g}' for s in sides)} m"
+        centre = np.asarray(obstacle.pose.getTranslation())
+        if np.hypot(centre[0], centre[1]) < self.base_clearance - GEOMETRY_TOL:
+            return f"has its centre {np.hypot(centre[0], centre[1]):.3g} m from the base axis"
+        return None
+
+    def held_misfit(self, shape: coal.CollisionGeometry) -> str | None:
+        """Why a held ``shape`` is not a trained stick (None: it is one)."""
+        if not isinstance(shape, coal.Box):
+            return f"a held {shape_kind(shape)}"
+        w1, w2, length = np.sort(2.0 * np.asarray(shape.halfSide))
+        lo, hi = self.stick_length
+        wlo, whi = self.stick_width
+        t = GEOMETRY_TOL
+        if not (lo - t <= length <= hi + t and wlo - t <= w1 <= w2 <= whi + t):
+            return f"a held box of sides {w1:.3g} × {w2:.3g} × {length:.3g} m"
+        return None
+
+
+TRAINED = {  # environment -> its obstacles
+    "ur5e_boxes": Boxes(BOX_SIZE, BASE_CLEARANCE),
+    "ur5e_storage": StorageBoxes(
+        max(TABLE[0][1] - TABLE[0][0], TABLE[1][1] - TABLE[1][0]),
+        BASE_CLEARANCE,
+        STICK_LENGTH,
+        STICK_WIDTH,
+    ),
+}
 
 
 def shape_kind(shape: coal.CollisionGeometry) -> str:
@@ -97,20 +158,20 @@ def check_fits3d(card: dict, rim: int, scene: object) -> None:
             f"scene: GraphDistNet-3D weights take 3-D scenes, got a {type(scene).__name__}; use "
             "planar weights (e.g. 'd') for a planar scene"
         )
-    robot = card.get("robot")
-    if robot is not None:
-        _check_robot(str(robot), rim, scene)
-    if not scene.obstacles:
-        raise InputError("scene.obstacles: GraphDistNet-3D needs at least one obstacle")
     env = card.get("env")
-    if env is None:
-        return
-    trained = TRAINED.get(env)
-    if trained is None:
+    trained = TRAINED.get(env) if env is not None else None
+    if env is not None and trained is None:
         raise InputError(
             f"weights: the card's training environment {env!r} is not one whose scenes gdnplan "
             f"knows ({', '.join(TRAINED)}); {COAL}"
         )
+    robot = card.get("robot")
+    if robot is not None:
+        _check_robot(str(robot), rim, scene, getattr(trained, "held_misfit", None))
+    if not scene.obstacles:
+        raise InputError("scene.obstacles: GraphDistNet-3D needs at least one obstacle")
+    if trained is None:
+        return
     for i, obstacle in enumerate(scene.obstacles):
         why = trained.misfit(obstacle)
         if why is not None:
@@ -121,18 +182,26 @@ def check_fits3d(card: dict, rim: int, scene: object) -> None:
             )
 
 
-def _check_robot(robot: str, rim: int, scene: Scene3D) -> None:
+def _check_robot(robot: str, rim: int, scene: Scene3D, held_misfit=None) -> None:
+    """The robot rules (module docstring); ``held_misfit``: the environment's test of a held
+    shape (None: holding is refused), whose nodes are then left out of the comparison."""
     have = scene.robot
     if have.name != robot:
         raise InputError(
             f"scene: these weights were trained for robot {robot!r}, not {have.name!r}; {COAL}"
         )
     trained, graph = robot_graph3d(load_robot3d(robot), rim), robot_graph3d(have, rim)
+    keep = np.ones(graph.n_nodes, bool)
     what = None
-    if graph.n_nodes != trained.n_nodes or not np.array_equal(graph.body, trained.body):
+    if held_misfit is not None and HELD_LINK in have.links:
+        carried = [s.shape for s in have.shapes if s.link == HELD_LINK]
+        what = held_misfit(carried[0]) if len(carried) == 1 else f"{len(carried)} held shapes"
+        keep = graph.link != have.links.index(HELD_LINK)
+    same_nodes = int(keep.sum()) == trained.n_nodes
+    if what is None and (not same_nodes or not np.array_equal(graph.body[keep], trained.body)):
         what = f"{graph.n_nodes} graph nodes against {trained.n_nodes}"
-    else:
-        moved = float(np.linalg.norm(graph.local - trained.local, axis=1).max())
+    elif what is None:
+        moved = float(np.linalg.norm(graph.local[keep] - trained.local, axis=1).max())
         if moved > NODE_TOL:
             what = f"link nodes moved up to {moved:.3g} m"
     if what is not None:
@@ -145,4 +214,12 @@ def _check_robot(robot: str, rim: int, scene: Scene3D) -> None:
         )
 
 
-__all__ = ["GEOMETRY_TOL", "NODE_TOL", "TRAINED", "Boxes", "check_fits3d", "shape_kind"]
+__all__ = [
+    "GEOMETRY_TOL",
+    "NODE_TOL",
+    "TRAINED",
+    "Boxes",
+    "StorageBoxes",
+    "check_fits3d",
+    "shape_kind",
+]
