@@ -2,15 +2,15 @@
 the compiled stages called one by one from Python, tile by tile, for n random configurations
 of one scene (float32, one thread).
 
-    python benchmarks/fused_profile.py [--env e] [--n 5000] [--repeats 3]
+    python benchmarks/fused_profile.py [--env e] [--n 5000] [--repeats 3] [--out FILE.md]
 """
 
 from __future__ import annotations
 
-import argparse
 import time
 from collections import defaultdict
 
+import common
 import numpy as np
 import torch
 
@@ -85,12 +85,13 @@ def profile(packed, x, seconds) -> None:
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__)
+    p = common.parser("fused_profile", __doc__)
     p.add_argument("--env", default="e")
     p.add_argument("--n", type=int, default=5000)
     p.add_argument("--repeats", type=int, default=3)
-    args = p.parse_args()
+    args = common.parse(p)
     torch.set_num_threads(1)
+    report = common.Report(args, "Whole-pass stage profile", common.first_paragraph(__doc__))
     scene = gp.make_scene(args.env, seed=0)
     q = scene.robot.sample(args.n, seed=0)
     model = gp.load_model(default_weights(scene))
@@ -114,11 +115,15 @@ def main() -> None:
             profile(packed, x, seconds)
             if best is None or sum(seconds.values()) < sum(best.values()):
                 best = seconds
-    print(f"env {args.env}, n {args.n}, n rows {packed.net.ring.shape[1]}, tile {tile}")
-    print(f"whole pass (d + grad, one call): {whole:.3f} s thread CPU")
+    report.text(
+        f"env {args.env}, n {args.n}, rows {packed.net.ring.shape[1]}, tile {tile}; whole pass "
+        f"(d + grad, one call): {whole:.3f} s thread CPU (best of {args.repeats + 1})"
+    )
+    table = report.table("stage", "thread CPU (s)")
     for name, s in best.items():
-        print(f"  {name:18s} {s:.3f} s")
-    print(f"  {'sum of stages':18s} {sum(best.values()):.3f} s")
+        table.add(name, f"{s:.3f}")
+    table.add("sum of stages", f"{sum(best.values()):.3f}")
+    report.write()
 
 
 if __name__ == "__main__":
