@@ -16,14 +16,16 @@ or contact terms) and scored on the same held-out samples:
 
 :func:`faithful_config` is the faithful network's run for Table I: the data and the time
 budget of the shipped (best) weights of the environment, :data:`BEST` (their cards).
-Every trained step is kept (``runs/ablation/<env>/<step>-s<seed>.safetensors`` + card, its
-scores in ``….scores.json``) and skipped when present; an interrupted training resumes from its
+Every trained step is kept (``results/ablation/<env>/<step>-s<seed>.safetensors`` + card, its
+scores in ``….scores.json``; the repository keeps them, so the ≈ 14 h run accumulates over
+sessions) and skipped when present; an interrupted training resumes from its
 checkpoint.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -38,6 +40,7 @@ from .train import FitConfig, GraphDistNetLoss, TrainConfig
 __all__ = [
     "BEST",
     "ENVS",
+    "RUNS_DIR",
     "STEPS",
     "Best",
     "Settings",
@@ -192,12 +195,16 @@ def score(weights: Path, env: str, s: Settings) -> dict:
     return out
 
 
+def _weights_path(runs: Path, env: str, step: int, seed: int) -> Path:
+    return runs / env / f"{STEPS[step][0]}-s{seed}.safetensors"
+
+
 def train_step(env: str, step: int, seed: int, s: Settings, data_root: Path, runs: Path) -> Path:
     """Train ``STEPS[step]`` with ``seed`` (skipped when its weights exist); their path."""
     from .train import train
 
-    name = f"{STEPS[step][0]}-s{seed}"
-    out = runs / env / f"{name}.safetensors"
+    out = _weights_path(runs, env, step, seed)
+    name = out.stem
     if out.exists():
         return out
     best = BEST[env]
@@ -208,25 +215,35 @@ def train_step(env: str, step: int, seed: int, s: Settings, data_root: Path, run
     return out
 
 
+RUNS_DIR = Path("results/ablation")  # trained steps, kept in the repository between sessions
+
+
 def run(
     envs: tuple[str, ...] = ENVS,
     seeds: int = 2,
     s: Settings | None = None,
     data_root: Path | str = DATA_DIR,
-    runs: Path | str = Path("runs/ablation"),
+    runs: Path | str = RUNS_DIR,
     log: Callable[[str], None] = print,
+    train_for: float = math.inf,
 ) -> dict[str, list[list[dict]]]:
-    """{env: [[scores of each seed] for each step]}, training and scoring what is missing."""
+    """{env: [[scores of each trained seed] for each step]}, training and scoring what is
+    missing. No step starts training once ``train_for`` seconds (wall) have passed (0: report
+    the kept steps only); steps left untrained have fewer seeds' scores, or none."""
     s = s or Settings()
     data_root, runs = Path(data_root), Path(runs)
+    deadline = time.monotonic() + train_for
     out: dict[str, list[list[dict]]] = {}
     for env in envs:
-        if not split_dir(env, "train", data_root).is_dir():
+        if train_for > 0 and not split_dir(env, "train", data_root).is_dir():
             raise FileNotFoundError(f"{split_dir(env, 'train', data_root)}: generate it first")
         out[env] = []
         for step in range(len(STEPS)):
             per_seed = []
             for seed in range(seeds):
+                weights = _weights_path(runs, env, step, seed)
+                if not weights.exists() and time.monotonic() >= deadline:
+                    continue
                 weights = train_step(env, step, seed, s, data_root, runs)
                 cached = weights.with_suffix(".scores.json")
                 if not cached.exists():
@@ -251,6 +268,9 @@ def markdown(results: dict[str, list[list[dict]]], s: Settings) -> str:
     lines = [head, "|" + "---|" * 11]
     for env, steps in results.items():
         for (name, change, _), runs in zip(STEPS, steps, strict=True):
+            if not runs:
+                lines.append(f"| {env} | {name} | {change} |" + " not trained yet |" * 8)
+                continue
             t2 = "–", "–"
             if all("t2_success" in r for r in runs):
                 ok, n = sum(r["t2_success"] for r in runs), sum(r["t2_n"] for r in runs)

@@ -1,5 +1,7 @@
 """The ablation (gdnplan.ablation): one change a step, resumable, and its --fast CLI run."""
 
+import json
+import time
 from dataclasses import fields
 
 import pytest
@@ -63,3 +65,45 @@ def test_fast_cli_writes_the_table_and_refuses_bad_input(tmp_path):
 def test_faithful_cli_refuses_an_unknown_env(env):
     result = CliRunner().invoke(app, ["reproduce", "faithful", "--env", env])
     assert result.exit_code != 0 and "--env" in str(result.exception)
+
+
+def test_report_only_uses_the_kept_steps_and_trains_none(tmp_path, monkeypatch):
+    """``train_for=0``: the table of what is kept (here one seed of the first step), the rest
+    marked untrained; nothing is trained and no data is needed."""
+    kept = tmp_path / "runs" / "b" / "faithful-s0.safetensors"
+    kept.parent.mkdir(parents=True)
+    kept.write_bytes(b"")
+    scores = {"mae": 0.0123, "auc": 0.9987, "acd": 0.2, "n_test": 5000, "seconds": 1200.0,
+              "epochs": 9, "grad_time": 2e-4, "sweep_max": 0.03}  # fmt: skip
+    kept.with_suffix(".scores.json").write_text(json.dumps(scores))
+
+    def no_training(*args, **kwargs):
+        raise AssertionError("report-only trained a step")
+
+    monkeypatch.setattr(training, "train", no_training)
+    out = ablation.run(("b",), 2, ablation.Settings(), tmp_path / "none", tmp_path / "runs",
+                       log=lambda m: None, train_for=0)  # fmt: skip
+    assert [len(seeds) for seeds in out["b"]] == [1] + [0] * (len(ablation.STEPS) - 1)
+    text = ablation.markdown(out, ablation.Settings())
+    assert "| b | faithful |" in text and "| 12.30 | 0.9987 | 0.200 |" in text
+    assert text.count(" not trained yet |" * 8) == len(ablation.STEPS) - 1
+
+
+def test_train_for_stops_starting_new_steps(tmp_path, monkeypatch):
+    """Once ``train_for`` has passed, steps not yet kept are left for a later run."""
+    root = tmp_path / "data"
+    data.split_dir("b", "train", root).mkdir(parents=True)
+    calls = []
+
+    def fake_train(env, config, name, data_root, out, run_dir):
+        calls.append(name)
+        time.sleep(0.05)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_bytes(b"")
+        out.with_suffix(".scores.json").write_text(json.dumps({"mae": 0.01}))
+
+    monkeypatch.setattr(training, "train", fake_train)
+    out = ablation.run(("b",), 1, ablation.Settings(), root, tmp_path / "runs",
+                       log=lambda m: None, train_for=0.01)  # fmt: skip
+    assert calls == ["faithful-s0"]  # started before the limit, the rest not
+    assert [len(seeds) for seeds in out["b"]] == [1] + [0] * (len(ablation.STEPS) - 1)

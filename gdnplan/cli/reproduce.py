@@ -196,7 +196,12 @@ def ablation_command(
     seeds: int = typer.Option(2, min=1, help="Training seeds per step."),
     budget: float = typer.Option(1200.0, help="Training seconds per step and seed (> 0)."),
     data: Path = typer.Option(None, help="Data root (default data/; --fast: a temporary one)."),
-    runs: Path = typer.Option(Path("runs/ablation"), help="Trained steps (kept, skipped)."),
+    runs: Path = typer.Option(
+        Path("results/ablation"), help="Trained steps (kept in the repository, skipped)."
+    ),
+    train_for: float = typer.Option(
+        None, help="Start no training after this many seconds (0: table of the kept steps)."
+    ),
     out: Path = typer.Option(Path("results/ablation.md"), help="Markdown output."),
 ) -> None:
     """Faithful → soft partners → one-way → node distances → soft-minimum readout → probe
@@ -213,6 +218,8 @@ def ablation_command(
         raise InputError(f"--envs: expected some of {sorted(ablation.BEST)}, got {envs!r}")
     if not budget > 0:
         raise InputError(f"--budget: expected a positive number of seconds, got {budget}")
+    if train_for is not None and not 0 <= train_for < float("inf"):
+        raise InputError(f"--train-for: expected seconds ≥ 0, got {train_for}")
     set_threads(1, torch_global=True)
     s = ablation.Settings.fast() if fast else ablation.Settings(budget=budget)
     with tempfile.TemporaryDirectory() as tmp:
@@ -224,7 +231,10 @@ def ablation_command(
                     target = split_dir(env, split, root)
                     if not target.exists():
                         generate(env, n, seed, target, workers=1)
-        results = ablation.run(chosen, seeds, s, root, runs, log=lambda m: typer.echo(m, err=True))
+        limit = float("inf") if train_for is None else train_for
+        results = ablation.run(
+            chosen, seeds, s, root, runs, log=lambda m: typer.echo(m, err=True), train_for=limit
+        )
     command = (
         f"gdnplan reproduce ablation{' --fast' if fast else ''} --envs {','.join(chosen)} "
         f"--seeds {seeds}" + ("" if fast else f" --budget {budget:g}")
