@@ -307,3 +307,48 @@ def test_arm_in_any_plane_is_accepted_and_a_tilted_plane_refused(rpy, lengths, t
         gp.robot_from_urdf(
             "arm", RobotSpec(urdf=path, planning_joints=("j1", "j2"), plane_axes=slight)
         )
+
+
+def mimic_arm(folder: Path) -> Path:
+    """j1 → j2 → j3 about z; j2 mimics j1 (a parallel linkage: j2 = 2 j1 + 0.1)."""
+    j2 = joint("j2", "l1", "l2", xyz="0.4 0 0").replace(
+        "</joint>", '<mimic joint="j1" multiplier="2" offset="0.1"/></joint>'
+    )
+    return write_urdf(
+        folder,
+        '<link name="base"/>',
+        joint("j1", "base", "l1"),
+        link("l1"),
+        j2,
+        link("l2"),
+        joint("j3", "l2", "l3", xyz="0.4 0 0"),
+        link("l3"),
+    )
+
+
+@pytest.mark.parametrize("planning", [("j1",), ("j2",), ("j1", "j2"), ("j1", "j2", "j3"), None])
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_a_planning_joint_in_a_mimic_pair_is_refused(tmp_path, planning, kind):
+    """Pinocchio reads a <mimic> joint as independent: planning either joint of the pair would
+    plan (and certify) another robot than the URDF's, so the loaders refuse it by name."""
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = mimic_arm(tmp_path)
+    with pytest.raises(InputError, match="'j2' mimics joint 'j1'"):
+        if kind == "planar":
+            spec = RobotSpec(urdf=path, planning_joints=planning or ("j1", "j2", "j3"))
+            robot_from_urdf("mimic_arm", spec)
+        else:
+            robot3d_from_urdf(path, joints=planning)
+
+
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_a_locked_mimic_pair_still_loads(tmp_path, kind):
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = mimic_arm(tmp_path)
+    if kind == "planar":
+        spec = RobotSpec(urdf=path, planning_joints=("j3",), locked={"j1": 0.2, "j2": 0.5})
+        assert robot_from_urdf("mimic_arm", spec).dof == 1
+    else:
+        assert robot3d_from_urdf(path, joints=["j3"], locked={"j1": 0.2, "j2": 0.5}).dof == 1

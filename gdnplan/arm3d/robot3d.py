@@ -29,6 +29,7 @@ import pinocchio as pin
 from ..errors import InputError, UnknownNameError
 from ..robot import as_batch
 from ..urdf_robot import RobotSpec, load_urdf
+from ..urdf_robot.load import check_mimic
 from .pairs import self_collision_pairs
 from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
 
@@ -194,6 +195,7 @@ def robot3d_from_urdf(
     if joints is None and any(model.joints[model.getJointId(j)].nq == 2 for j in planning):
         model, geom = load_urdf(RobotSpec(path, tuple(planning), package_dirs=dirs))
     _check_joints(model, planning, movable, path.name)
+    check_mimic(path, planning)
     q_ref = _locked_configuration(model, planning, locked or {}, path.name)
     lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in planning]
     reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)

@@ -21,7 +21,8 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
 
     Continuous planning joints become revolute joints limited to [−π, π] (Pinocchio gives a
     continuous joint two coordinates, cos θ and sin θ). UnknownNameError for a missing file;
-    InputError for one that does not parse, with the parser's first complaint.
+    InputError for one that does not parse, with the parser's first complaint, and for a
+    planning joint that is a ``<mimic>`` joint or is mimicked (:func:`check_mimic`).
     """
     path = Path(spec.urdf)
     try:
@@ -35,6 +36,7 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     except (OSError, ET.ParseError) as e:
         reason = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
+    _check_mimic(root, spec.planning_joints, path)
     rewritten = False
     for joint in root.iter("joint"):
         if joint.get("type") == "continuous" and joint.get("name") in spec.planning_joints:
@@ -67,6 +69,30 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     reason = (reason.removeprefix("Error:").strip() or str(error) or "no reason given").strip()
     reason = reason.splitlines()[0]
     raise InputError(f"urdf: {path} is not a valid URDF: {reason}") from error
+
+
+def check_mimic(urdf: str | Path, planning) -> None:
+    """InputError when a planning joint of the URDF file is a ``<mimic>`` joint or mimicked.
+
+    Pinocchio reads a mimic joint as an independent joint, so gdnplan would plan it on its own
+    or hold it locked while its master moves: distances and certificates would be those of
+    another robot than the URDF describes."""
+    _check_mimic(ET.fromstring(Path(urdf).read_bytes()), planning, Path(urdf))
+
+
+def _check_mimic(root: ET.Element, planning, path: Path) -> None:
+    planned = set(planning or ())
+    for joint in root.iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is None:
+            continue
+        follower, master = joint.get("name"), mimic.get("joint")
+        if follower in planned or master in planned:
+            raise InputError(
+                f"joints: joint {follower!r} mimics joint {master!r} (<mimic> in {path.name}); "
+                "gdnplan moves planning joints independently and would not move them together: "
+                "lock both joints, or plan a URDF without the <mimic>"
+            )
 
 
 @contextlib.contextmanager
