@@ -162,8 +162,11 @@ def certify_path(
     """
     _check_args(margin, tol, min_splits, max_checks)
     robot = scene.robot
+    q_path = robot.check_q(q_path, "q_path")
+    if not len(q_path):
+        raise InputError("q_path: expected at least one waypoint, got none")
     return certify_by_bisection(
-        robot.check_q(q_path, "q_path"),
+        q_path,
         lambda q: signed_distance(scene, q),
         lambda qa, qb: motion_bound(robot, qa, qb),
         margin,

@@ -170,6 +170,15 @@ def test_bad_certificate_arguments_are_input_errors(kwargs):
         certify_path(scene, np.zeros((2, 2)), **kwargs)
 
 
+@pytest.mark.parametrize(
+    "q_path", [np.zeros((0, 2)), [], np.zeros((3, 0)), np.zeros((2, 3)), [[0.0, math.nan]], "ab"]
+)
+def test_bad_paths_are_input_errors(q_path):
+    """No waypoint, the wrong joint count, NaN or text: InputError naming q_path."""
+    with pytest.raises(InputError, match="q_path"):
+        certify_path(gp.make_scene("a"), q_path)
+
+
 @pytest.mark.parametrize("name", ["a", "b", "c", "d", "e", "fetch"])
 def test_coal_overestimates_by_at_most_its_slack(name):
     """The slack the certificate subtracts covers coal's GJK error (shapely is exact)."""
