@@ -352,3 +352,42 @@ def test_a_locked_mimic_pair_still_loads(tmp_path, kind):
         assert robot_from_urdf("mimic_arm", spec).dof == 1
     else:
         assert robot3d_from_urdf(path, joints=["j3"], locked={"j1": 0.2, "j2": 0.5}).dof == 1
+
+
+@pytest.mark.parametrize("axis", ["0 0 0", "0 0 1e-300", "1e-200 1e-200 0", "0 0 -1e-310"])
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_a_joint_axis_that_is_no_direction_is_refused(tmp_path, axis, kind):
+    """Pinocchio keeps a zero axis (the joint never moves) and one too small to normalise (its
+    "rotations" scale and shear links): both loaders refuse them, naming the joint."""
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = two_link(tmp_path, axis2=axis)
+    with pytest.raises(InputError, match=r"joint 'j2' .* not a direction"):
+        if kind == "planar":
+            robot_from_urdf("axis_arm", RobotSpec(urdf=path, planning_joints=("j1", "j2")))
+        else:
+            robot3d_from_urdf(path)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).filter(
+        lambda a: np.linalg.norm(a) > 1e-3
+    ),
+    st.sampled_from([1e-12, 1e-3, 1.0, 7.5, 1e9]),
+)
+def test_any_nonzero_joint_axis_acts_as_its_unit_direction(direction, scale):
+    """A 3-D arm's joint turns about axis / |axis| whatever the length the URDF gives."""
+    from gdnplan.arm3d import robot3d_from_urdf
+    from gdnplan.arm3d.fk3d import body_placements_batch
+
+    with tempfile.TemporaryDirectory() as folder:
+        axis = " ".join(repr(x * scale) for x in direction)
+        robot = robot3d_from_urdf(two_link(Path(folder), axis2=axis))
+    q = np.array([[0.3, 1.1]])
+    rotation = body_placements_batch(robot, q)[0, 2, :3, :3]
+    unit = np.asarray(direction) / np.linalg.norm(direction)
+    expected = (
+        pin.AngleAxis(0.3, np.array([0.0, 0.0, 1.0])).matrix() @ pin.AngleAxis(1.1, unit).matrix()
+    )
+    assert np.allclose(rotation, expected, atol=1e-9)

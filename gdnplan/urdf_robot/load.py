@@ -15,6 +15,8 @@ import pinocchio as pin
 from ..errors import InputError, UnknownNameError
 from .spec import RobotSpec
 
+AXIS_UNIT_TOLERANCE = 1e-9  # largest | |axis| − 1 | of a joint axis after Pinocchio's parse
+
 
 def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     """Pinocchio model and collision geometry of ``spec.urdf``.
@@ -64,11 +66,29 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
         except (ValueError, RuntimeError) as e:
             error = e
         else:
+            _check_joint_axes(model, path)
             return model, geom
     reason = next((line.strip() for line in log if line.strip().startswith("Error:")), "")
     reason = (reason.removeprefix("Error:").strip() or str(error) or "no reason given").strip()
     reason = reason.splitlines()[0]
     raise InputError(f"urdf: {path} is not a valid URDF: {reason}") from error
+
+
+def _check_joint_axes(model: pin.Model, path: Path) -> None:
+    """InputError naming the first joint whose axis Pinocchio could not make a unit vector:
+    ``<axis xyz="0 0 0"/>`` or one so small its norm underflows (a zero axis never moves; a
+    non-unit one turns links by non-rotations, and no distance or certificate holds)."""
+    for j in range(1, model.njoints):
+        axis = getattr(model.joints[j].extract(), "axis", None)
+        if axis is None:
+            continue
+        norm = float(np.linalg.norm(np.asarray(axis, float)))
+        if not abs(norm - 1.0) <= AXIS_UNIT_TOLERANCE:
+            raise InputError(
+                f"urdf: joint {model.names[j]!r} of {path.name} has the axis "
+                f"{np.asarray(axis, float).tolist()}, not a direction; give a nonzero "
+                '<axis xyz="x y z"/>'
+            )
 
 
 def check_mimic(urdf: str | Path, planning) -> None:
