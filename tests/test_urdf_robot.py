@@ -391,3 +391,47 @@ def test_any_nonzero_joint_axis_acts_as_its_unit_direction(direction, scale):
         pin.AngleAxis(0.3, np.array([0.0, 0.0, 1.0])).matrix() @ pin.AngleAxis(1.1, unit).matrix()
     )
     assert np.allclose(rotation, expected, atol=1e-9)
+
+
+def far_origins(folder: Path, out: str, back: str, collision: str = "0 0 0") -> Path:
+    """j1 about z, then fixed joints ``out`` and ``back`` along x, a box at ``collision``."""
+    box = f'<collision><origin xyz="{collision}"/><geometry><box size="0.1 0.1 0.1"/></geometry>'
+    return write_urdf(
+        folder,
+        '<link name="base"/>',
+        joint("j1", "base", "l1"),
+        '<link name="l1"/>',
+        joint("out", "l1", "l2", kind="fixed", xyz=f"{out} 0 0"),
+        '<link name="l2"/>',
+        joint("back", "l2", "l3", kind="fixed", xyz=f"{back} 0 0"),
+        f'<link name="l3">{box}</collision></link>',
+    )
+
+
+@pytest.mark.parametrize(
+    "out, back, collision",
+    [
+        ("1e20", "-99999999999999999999.4", "0 0 0"),  # the box is 0.6 m out; doubles say 0
+        ("1e300", "0", "0 0 0"),
+        ("0.3", "0.3", "0 0 1e300"),
+        ("1000.5", "-1000", "0 0 0"),
+    ],
+)
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_an_origin_beyond_a_kilometre_is_refused(tmp_path, out, back, collision, kind):
+    """Far origins lose links' positions to rounding (or overflow coal): refused by name."""
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = far_origins(tmp_path, out, back, collision)
+    with pytest.raises(InputError, match=r"origin of .* beyond 1000 m"):
+        if kind == "planar":
+            robot_from_urdf("far_arm", RobotSpec(urdf=path, planning_joints=("j1",)))
+        else:
+            robot3d_from_urdf(path)
+
+
+def test_origins_within_a_kilometre_still_load(tmp_path):
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    robot = robot3d_from_urdf(far_origins(tmp_path, "999.5", "-999", "0 0 0.1"))
+    assert robot.dof == 1

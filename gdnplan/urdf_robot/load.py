@@ -16,6 +16,7 @@ from ..errors import InputError, UnknownNameError
 from .spec import RobotSpec
 
 AXIS_UNIT_TOLERANCE = 1e-9  # largest | |axis| − 1 | of a joint axis after Pinocchio's parse
+MAX_OFFSET = 1e3  # m: largest |coordinate| of a joint origin or a collision origin
 
 
 def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
@@ -39,6 +40,7 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
         reason = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
     _check_mimic(root, spec.planning_joints, path)
+    _check_origins(root, path)
     rewritten = False
     for joint in root.iter("joint"):
         if joint.get("type") == "continuous" and joint.get("name") in spec.planning_joints:
@@ -88,6 +90,28 @@ def _check_joint_axes(model: pin.Model, path: Path) -> None:
                 f"urdf: joint {model.names[j]!r} of {path.name} has the axis "
                 f"{np.asarray(axis, float).tolist()}, not a direction; give a nonzero "
                 '<axis xyz="x y z"/>'
+            )
+
+
+def _check_origins(root: ET.Element, path: Path) -> None:
+    """InputError naming the first joint or collision ``<origin xyz>`` beyond ``MAX_OFFSET``
+    along an axis: there floating point loses a link's position (a fixed joint 1e20 m out and
+    one −99999999999999999999.4 m back put a link at 0, not 0.6 m) and coal's distances
+    overflow, so no certificate would describe the URDF's robot."""
+    owners = [(f"joint {j.get('name')!r}", j) for j in root.iter("joint")]
+    owners += [(f"a collision of link {k.get('name')!r}", c) for k in root.iter("link")
+               for c in k.iter("collision")]  # fmt: skip
+    for what, element in owners:
+        origin = element.find("origin")
+        text = "" if origin is None else origin.get("xyz", "")
+        try:
+            xyz = np.array([float(x) for x in text.split()])
+        except ValueError:
+            continue  # urdfdom names the malformed number
+        if not np.all(np.abs(xyz) <= MAX_OFFSET):
+            raise InputError(
+                f"urdf: the origin of {what} in {path.name} is {xyz.tolist()} m, beyond "
+                f"{MAX_OFFSET:g} m along an axis; use metres near the robot"
             )
 
 
