@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -135,3 +136,27 @@ def test_unknown_names_and_joint_order(tmp_path):
     srdf.write_text('<robot><disable_collisions link1="x" link2="base_link"/></robot>')
     with pytest.raises(InputError, match="link 'x'"):
         robot3d_from_urdf(robot_urdf("ur5e"), srdf=srdf)
+
+
+ARM = Path(__file__).resolve().parent.parent / "examples" / "three_link_arm.urdf"
+
+
+@pytest.mark.parametrize("angle", [-2.5, 0.0, 1.0, 3.0, 7.0])
+def test_a_locked_continuous_joint_sits_where_planning_it_would_put_it(angle):
+    """three_link_arm's continuous wrist locked at an angle places every shape as the robot
+    that plans the wrist does at that angle (Pinocchio stores it as cos θ, sin θ)."""
+    from gdnplan.arm3d.fk3d import shape_placements_batch
+
+    roll = {"tool_roll": 0.5}
+    locked = robot3d_from_urdf(ARM, joints=["shoulder", "elbow"], locked={"wrist": angle, **roll})
+    planned = robot3d_from_urdf(ARM, joints=["shoulder", "elbow", "wrist"], locked=roll)
+    wrapped = np.arctan2(np.sin(angle), np.cos(angle))  # the planned wrist lives in [−π, π]
+    a = shape_placements_batch(locked, np.array([[0.3, -0.2]]))
+    b = shape_placements_batch(planned, np.array([[0.3, -0.2, wrapped]]))
+    assert np.allclose(a, b, atol=1e-12)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf")])
+def test_a_non_finite_locked_value_is_refused_as_such(value):
+    with pytest.raises(InputError, match="'wrist' needs a finite number"):
+        robot3d_from_urdf(ARM, joints=["shoulder", "elbow"], locked={"wrist": value})
