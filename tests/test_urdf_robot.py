@@ -435,3 +435,28 @@ def test_origins_within_a_kilometre_still_load(tmp_path):
 
     robot = robot3d_from_urdf(far_origins(tmp_path, "999.5", "-999", "0 0 0.1"))
     assert robot.dof == 1
+
+
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+@pytest.mark.parametrize("j1", [-0.4, 0.0, 0.2, 1.3])
+def test_a_locked_mimic_follower_follows_its_master(tmp_path, kind, j1):
+    """Unlisted, j2 sits at 2 j1 + 0.1 (as on the real robot); listed elsewhere, refused."""
+    from gdnplan.arm3d import robot3d_from_urdf
+    from gdnplan.arm3d.fk3d import shape_placements_batch
+
+    path = mimic_arm(tmp_path)
+
+    def build(locked):
+        if kind == "planar":
+            spec = RobotSpec(urdf=path, planning_joints=("j3",), locked=locked)
+            return robot_from_urdf("mimic_arm", spec)
+        return robot3d_from_urdf(path, joints=["j3"], locked=locked)
+
+    follows, explicit = build({"j1": j1}), build({"j1": j1, "j2": 2 * j1 + 0.1})
+    q = np.array([[0.7]])
+    if kind == "planar":
+        assert np.allclose(follows.link_polygons(q[0])[-1], explicit.link_polygons(q[0])[-1])
+    else:
+        assert np.allclose(shape_placements_batch(follows, q), shape_placements_batch(explicit, q))
+    with pytest.raises(InputError, match="'j2' mimics 'j1'"):
+        build({"j1": j1, "j2": 2 * j1 + 0.2})

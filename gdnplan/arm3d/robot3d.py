@@ -29,7 +29,7 @@ import pinocchio as pin
 from ..errors import InputError, UnknownNameError
 from ..robot import as_batch
 from ..urdf_robot import CONTINUOUS, RobotSpec, load_urdf
-from ..urdf_robot.load import check_mimic
+from ..urdf_robot.load import check_mimic, lock_mimics
 from .pairs import self_collision_pairs
 from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
 
@@ -197,6 +197,7 @@ def robot3d_from_urdf(
     _check_joints(model, planning, movable, path.name)
     check_mimic(path, planning)
     q_ref = _locked_configuration(model, planning, locked or {}, path.name)
+    lock_mimics(model, q_ref, path, set(locked or {}))
     lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in planning]
     reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
     shapes = [_link_shape(reduced, obj) for obj in reduced_geom.geometryObjects]
