@@ -210,7 +210,8 @@ def certify_by_bisection(
             reasons.append("a checked configuration is within the margin")
             if stop_early:
                 break
-        proven = ~hit & (bound > margin) & (bound >= best - tol)
+        close = bound >= best - tol if math.isfinite(tol) else True  # inf − inf is NaN
+        proven = ~hit & (bound > margin) & close
         stuck = ~hit & ~proven & (delta < MIN_PIECE)
         if stuck.any():
             bad.update(seg[stuck].tolist())

@@ -190,7 +190,11 @@ def test_coal_overestimates_by_at_most_its_slack(name):
     assert np.all(error <= COAL_SLACK * (1 + d[free]))
 
 
-def test_a_scene_without_obstacles_is_certified_at_once():
+@pytest.mark.parametrize("tol", [1e-3, 1.0, math.inf])
+@pytest.mark.parametrize("min_splits", [1, 10])
+def test_a_scene_without_obstacles_is_certified_at_once(tol, min_splits):
+    """Every distance is +inf: proven at once for any tol (inf − inf was NaN: with tol = inf,
+    the edge checks of RRT-Connect, nothing was ever proven and the budget ran out)."""
     empty = gp.make_scene("a").with_obstacles([])
-    cert = certify_path(empty, np.array([[0.0, 0.0], [0.5, 0.5]]))
-    assert cert.ok and cert.lower_bound == np.inf and cert.n_checks == 11  # no bisection
+    cert = certify_path(empty, np.array([[0.0, 0.0], [0.5, 0.5]]), tol=tol, min_splits=min_splits)
+    assert cert.ok and cert.lower_bound == np.inf and cert.n_checks == min_splits + 1
