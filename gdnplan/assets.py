@@ -19,7 +19,7 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .errors import UnknownNameError
+from .errors import InputError, UnknownNameError
 
 if TYPE_CHECKING:
     from .scene import Scene
@@ -53,6 +53,14 @@ def looks_like_path(ref: str | Path) -> bool:
     return "/" in ref or "\\" in ref or Path(ref).suffix != "" or ref in (".", "..")
 
 
+def _check_ref(ref, what: str) -> None:
+    """InputError unless ``ref`` is a name (str) or a path (os.PathLike)."""
+    if not isinstance(ref, (str, Path)):
+        raise InputError(
+            f"{what}: expected a shipped {what} name or a file path, got {type(ref).__name__}"
+        )
+
+
 def _shipped(ref: str, folder: Path, suffix: str, what: str, names: list[str]) -> Path:
     path = folder / f"{ref}{suffix}"
     if not path.is_file():
@@ -65,6 +73,7 @@ def _shipped(ref: str, folder: Path, suffix: str, what: str, names: list[str]) -
 def problem_file(ref: str | Path) -> Path:
     """The problem file ``ref`` names: a path as given (or an existing file), or a shipped
     problem by name (``"fetch_reach"``; see :func:`problem_names`)."""
+    _check_ref(ref, "problem")
     if looks_like_path(ref) or Path(ref).is_file():
         return Path(ref)
     return _shipped(str(ref), PROBLEMS_DIR, ".toml", "problem", problem_names())
@@ -72,6 +81,7 @@ def problem_file(ref: str | Path) -> Path:
 
 def weights_file(ref: str | Path) -> Path:
     """The weights file ``ref`` names: a path as given, or shipped weights by name."""
+    _check_ref(ref, "weights")
     if looks_like_path(ref):
         return Path(ref)
     return _shipped(str(ref), WEIGHTS_DIR, WEIGHTS_SUFFIX, "weights", weights_names())

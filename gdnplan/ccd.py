@@ -162,8 +162,11 @@ def certify_path(
     """
     _check_args(margin, tol, min_splits, max_checks)
     robot = scene.robot
+    q_path = robot.check_q(q_path, "q_path")
+    if not len(q_path):
+        raise InputError("q_path: expected at least one waypoint, got none")
     return certify_by_bisection(
-        robot.check_q(q_path, "q_path"),
+        q_path,
         lambda q: signed_distance(scene, q),
         lambda qa, qb: motion_bound(robot, qa, qb),
         margin,
@@ -207,7 +210,8 @@ def certify_by_bisection(
             reasons.append("a checked configuration is within the margin")
             if stop_early:
                 break
-        proven = ~hit & (bound > margin) & (bound >= best - tol)
+        close = bound >= best - tol if math.isfinite(tol) else True  # inf − inf is NaN
+        proven = ~hit & (bound > margin) & close
         stuck = ~hit & ~proven & (delta < MIN_PIECE)
         if stuck.any():
             bad.update(seg[stuck].tolist())

@@ -30,7 +30,10 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import InputError
+from .limits import check_int
 from .registry import ROBOTS
+
+MAX_SAMPLES = 10**8  # configurations of one Robot.sample call
 
 
 def rot2(theta: np.ndarray) -> np.ndarray:
@@ -226,7 +229,9 @@ class Robot:
 
     # ---------------------------------------------------------------- sampling and checks
     def sample(self, n: int, seed: int | None = 0) -> np.ndarray:
-        """(n, dof) configurations uniform within the joint limits."""
+        """(n, dof) configurations uniform within the joint limits; n an integer in
+        [0, MAX_SAMPLES], else InputError."""
+        check_int(n, "n", 0, MAX_SAMPLES)
         rng = np.random.default_rng(seed)
         return rng.uniform(self.lower, self.upper, size=(n, self.dof))
 

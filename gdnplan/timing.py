@@ -341,6 +341,7 @@ def time_path(
     max_velocity,
     max_acceleration=None,
     scene: Scene | Scene3D | None = None,
+    clearance: float = 0.0,
 ) -> TimedTrajectory:
     """Time-parametrise the certified waypoint path q (T, dof) rad; see the module docstring.
 
@@ -351,7 +352,11 @@ def time_path(
         scene: with max_acceleration, try the ``smooth`` curve and certify it here (a planar
             ``Scene`` or a ``Scene3D``); None (or a curve whose certificate fails, or toppra
             finding no solution): ``stop``.
+        clearance: the ``smooth`` curve must be proven to keep the exact distance above this
+            (m, finite, ≥ 0): the certified plan's clearance, so that the curve the robot
+            follows keeps what the plan promised; else ``stop`` (the certified polygon).
     """
+    check_number(clearance, "clearance")
     q = np.asarray(q, float)
     if q.ndim != 2 or len(q) < 1 or not np.all(np.isfinite(q)):
         raise InputError(f"q: expected finite (T, dof) waypoints (rad), got shape {q.shape}")
@@ -366,7 +371,7 @@ def time_path(
         from scipy.interpolate import PchipInterpolator
 
         curve = PchipInterpolator(knots, q[np.unique(index, return_index=True)[1]], axis=0)
-        cert = certify_curve(scene, curve)
+        cert = certify_curve(scene, curve, margin=clearance)
         prof = _toppra(curve, knots, v, a) if cert.ok else None
         if prof is not None:
             at_knots = prof.c * prof.ts[np.searchsorted(prof.grid, knots)]
@@ -382,6 +387,7 @@ def plan_timing(
     success: bool,
     max_velocity=None,
     max_acceleration=None,
+    clearance: float = 0.0,
 ) -> tuple[TimedTrajectory | None, str]:
     """The timing of a plan's path q (T, dof) and a note on why there is none ("" if there is).
 
@@ -389,7 +395,8 @@ def plan_timing(
     ``max_velocity`` is given (the note says which joint). ``max_acceleration`` selects the
     ``smooth`` curve certified in ``scene`` (or ``stop``), see :func:`time_path`, for planar
     and 3-D scenes alike (:mod:`gdnplan.ccd_curve` certifies the curve with the scene kind's
-    exact distance and motion bound; in 3-D self-collision included).
+    exact distance and motion bound; in 3-D self-collision included) to keep ``clearance``
+    (m): the plan's certified clearance.
     """
     if not success:
         return None, ""
@@ -398,7 +405,7 @@ def plan_timing(
     except InputError as e:
         return None, f"no timing: {e}"
     curve_scene = scene if max_acceleration is not None else None
-    return time_path(q, v, max_acceleration, curve_scene), ""
+    return time_path(q, v, max_acceleration, curve_scene, clearance), ""
 
 
 __all__ = [

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import itertools
+import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from gdnplan.arm3d import Scene3D, checker3d, load_robot3d, robot3d_from_urdf
 from gdnplan.arm3d.builtin import _example_robot_data
@@ -135,3 +139,77 @@ def test_unknown_names_and_joint_order(tmp_path):
     srdf.write_text('<robot><disable_collisions link1="x" link2="base_link"/></robot>')
     with pytest.raises(InputError, match="link 'x'"):
         robot3d_from_urdf(robot_urdf("ur5e"), srdf=srdf)
+
+
+ARM = Path(__file__).resolve().parent.parent / "examples" / "three_link_arm.urdf"
+
+
+@pytest.mark.parametrize("angle", [-2.5, 0.0, 1.0, 3.0, 7.0])
+def test_a_locked_continuous_joint_sits_where_planning_it_would_put_it(angle):
+    """three_link_arm's continuous wrist locked at an angle places every shape as the robot
+    that plans the wrist does at that angle (Pinocchio stores it as cos θ, sin θ)."""
+    from gdnplan.arm3d.fk3d import shape_placements_batch
+
+    roll = {"tool_roll": 0.5}
+    locked = robot3d_from_urdf(ARM, joints=["shoulder", "elbow"], locked={"wrist": angle, **roll})
+    planned = robot3d_from_urdf(ARM, joints=["shoulder", "elbow", "wrist"], locked=roll)
+    wrapped = np.arctan2(np.sin(angle), np.cos(angle))  # the planned wrist lives in [−π, π]
+    a = shape_placements_batch(locked, np.array([[0.3, -0.2]]))
+    b = shape_placements_batch(planned, np.array([[0.3, -0.2, wrapped]]))
+    assert np.allclose(a, b, atol=1e-12)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf")])
+def test_a_non_finite_locked_value_is_refused_as_such(value):
+    with pytest.raises(InputError, match="'wrist' needs a finite number"):
+        robot3d_from_urdf(ARM, joints=["shoulder", "elbow"], locked={"wrist": value})
+
+
+UR5E_ARM = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint")
+UR5E_WRIST = ("wrist_1_joint", "wrist_2_joint", "wrist_3_joint")
+
+
+@settings(max_examples=6, deadline=None)
+@given(st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3), st.integers(0, 2**31))
+def test_locked_joints_never_hide_a_self_collision(wrist, seed):
+    """The UR5e planning its arm with the wrist locked: every pair of links a locked joint
+    separates (the gripper against the upper arm, say) is checked; so wherever the pairwise
+    distances of all non-adjacent URDF links show a self-collision, so does the robot's."""
+    urdf = robot_urdf("ur5e")
+    locked = dict(zip(UR5E_WRIST, wrist, strict=True))
+    robot = robot3d_from_urdf(
+        urdf, joints=list(UR5E_ARM), locked=locked, srdf=urdf.with_suffix(".srdf")
+    )
+    adjacent = {k for k, why in robot.disabled.items() if why in ("adjacent", "same body")}
+    assert frozenset(("upper_arm_link", "gripper_base_link")) not in adjacent
+    # every adjacent pair is joined by one movable URDF joint, a planning one (fixed ones aside)
+    up = {}  # child link -> (parent link, joint name, joint type)
+    for j in ET.parse(urdf).getroot().iter("joint"):
+        up[j.find("child").get("link")] = (
+            j.find("parent").get("link"),
+            j.get("name"),
+            j.get("type"),
+        )
+
+    def movable_to_root(link):
+        chain = []
+        while link in up:
+            link, name, kind = up[link]
+            chain += [] if kind == "fixed" else [name]
+        return chain
+
+    for a, b in (tuple(k) for k, why in robot.disabled.items() if why == "adjacent"):
+        between = set(movable_to_root(a)) ^ set(movable_to_root(b))
+        assert len(between) == 1 and between <= set(UR5E_ARM), (a, b, between)
+    q = np.random.default_rng(seed).uniform(robot.lower, robot.upper, (40, robot.dof))
+    d = checker3d(Scene3D(robot, [])).evaluate(q).distance
+    # the same robot with the wrist planned, at the locked values: its pairs that the lock
+    # does not freeze (links on two bodies of the locked robot) give the same minimum
+    full = robot3d_from_urdf(
+        urdf, joints=list(UR5E_ARM + UR5E_WRIST), srdf=urdf.with_suffix(".srdf")
+    )
+    table = checker3d(Scene3D(full, []))
+    body = {s.link: s.body for s in robot.shapes}
+    moving = [body[a.split("/")[0]] != body[b.split("/")[0]] for a, b in table.pair_names()]
+    d_pairs, _ = table.pair_distances(np.c_[q, np.tile(wrist, (len(q), 1))])
+    assert np.allclose(d, d_pairs[:, moving].min(axis=1), atol=1e-9)

@@ -103,7 +103,10 @@ def test_the_table_is_clear_of_the_base_and_placements_off_it_are_flagged():
     assert not on_table(s, Placement(1.05, 0.0, 0.0))
 
 
-@pytest.mark.parametrize("bad", [(np.nan, 0, 0), (0.5, "a", 0), (0.5, 0, np.inf), (3.0, 0, 0)])
-def test_bad_placements_are_input_errors(bad):
-    with pytest.raises(InputError):
+@pytest.mark.parametrize(
+    "bad",
+    [(np.nan, 0, 0), (0.5, "a", 0), (0.5, 0, np.inf), (3.0, 0, 0), (None, 0, 0), (True, 0, 0)],
+)
+def test_bad_placements_are_input_errors_naming_the_placement(bad):
+    with pytest.raises(InputError, match=r"^placement: "):
         check_placement(*bad)

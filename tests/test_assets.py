@@ -190,3 +190,10 @@ def test_wheel_holds_every_shipped_file(tmp_path):
         if p.is_file() and "__pycache__" not in p.parts
     }
     assert shipped and shipped <= inside
+
+
+@pytest.mark.parametrize("ref", [None, 3, 1.5, b"d", ["d"]])
+@pytest.mark.parametrize("load", [gp.load_model, gp.Problem.from_toml])
+def test_a_reference_that_is_neither_name_nor_path_is_an_input_error(load, ref):
+    with pytest.raises(gp.InputError, match=r"expected a shipped .* name or a file path"):
+        load(ref)

@@ -170,6 +170,15 @@ def test_bad_certificate_arguments_are_input_errors(kwargs):
         certify_path(scene, np.zeros((2, 2)), **kwargs)
 
 
+@pytest.mark.parametrize(
+    "q_path", [np.zeros((0, 2)), [], np.zeros((3, 0)), np.zeros((2, 3)), [[0.0, math.nan]], "ab"]
+)
+def test_bad_paths_are_input_errors(q_path):
+    """No waypoint, the wrong joint count, NaN or text: InputError naming q_path."""
+    with pytest.raises(InputError, match="q_path"):
+        certify_path(gp.make_scene("a"), q_path)
+
+
 @pytest.mark.parametrize("name", ["a", "b", "c", "d", "e", "fetch"])
 def test_coal_overestimates_by_at_most_its_slack(name):
     """The slack the certificate subtracts covers coal's GJK error (shapely is exact)."""
@@ -181,7 +190,11 @@ def test_coal_overestimates_by_at_most_its_slack(name):
     assert np.all(error <= COAL_SLACK * (1 + d[free]))
 
 
-def test_a_scene_without_obstacles_is_certified_at_once():
+@pytest.mark.parametrize("tol", [1e-3, 1.0, math.inf])
+@pytest.mark.parametrize("min_splits", [1, 10])
+def test_a_scene_without_obstacles_is_certified_at_once(tol, min_splits):
+    """Every distance is +inf: proven at once for any tol (inf − inf was NaN: with tol = inf,
+    the edge checks of RRT-Connect, nothing was ever proven and the budget ran out)."""
     empty = gp.make_scene("a").with_obstacles([])
-    cert = certify_path(empty, np.array([[0.0, 0.0], [0.5, 0.5]]))
-    assert cert.ok and cert.lower_bound == np.inf and cert.n_checks == 11  # no bisection
+    cert = certify_path(empty, np.array([[0.0, 0.0], [0.5, 0.5]]), tol=tol, min_splits=min_splits)
+    assert cert.ok and cert.lower_bound == np.inf and cert.n_checks == min_splits + 1

@@ -3,7 +3,7 @@ import pytest
 import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from shapely.geometry import Polygon
+from shapely.geometry import Point, Polygon
 
 import gdnplan as gp
 from gdnplan import geometry as geo
@@ -135,3 +135,27 @@ def test_convex_decomposition_is_exact_at_the_vertex_limit():
     poly = _star(geo.MAX_VERTICES)  # the old O(n³) merge took 162 s at 400 vertices
     parts = geo.convex_decomposition(poly)
     assert sum(Polygon(p).area for p in parts) == pytest.approx(Polygon(poly).area, rel=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(0, 2**31),
+    st.integers(3, 80),
+    st.integers(3, 14),
+    st.sampled_from(["cloud", "circle", "thin"]),
+)
+def test_an_enclosing_polygon_contains_every_point_within_its_vertex_limit(seed, n, most, kind):
+    """Link polygons must contain their geometry's projection: the simplified polygon keeps at
+    most ``most`` vertices, stays convex and CCW, and leaves no point outside it."""
+    rng = np.random.default_rng(seed)
+    if kind == "circle":
+        a = np.linspace(0.0, 2 * np.pi, n, endpoint=False) + rng.uniform(0, 1)
+        pts = np.c_[np.cos(a), np.sin(a)] * rng.uniform(0.01, 1.0) + rng.uniform(-2, 2, 2)
+    else:
+        scale = [1.0, 1e-3] if kind == "thin" else rng.uniform(0.01, 2.0, 2)
+        pts = rng.normal(size=(n, 2)) * scale
+    poly = geo.enclosing_convex(pts, most)
+    assert 3 <= len(poly) <= most and geo.is_convex(poly) and geo.signed_area(poly) > 0
+    shape = Polygon(poly)
+    outside = [shape.exterior.distance(Point(p)) for p in pts if not shape.contains(Point(p))]
+    assert max(outside, default=0.0) <= 1e-9 * (1 + np.abs(pts).max())

@@ -62,3 +62,15 @@ def test_the_polish_never_returns_a_costlier_or_uncertified_path(square):
     assert polished.path_cost <= base.path_cost + 1e-12
     assert polished.min_distance > p.certified_clearance
     assert dense_min(square, polished.q) > p.certified_clearance
+
+
+@pytest.mark.parametrize("goal", [[0.4, -0.2], [-2.0, 1.0]])
+def test_a_free_straight_line_is_returned_as_is(square, goal):
+    """Without obstacles (or with a free straight line) the line is the plan: no repair or
+    polish solve runs on it, and it is certified (before, tol = inf never proved +inf)."""
+    empty = square.with_obstacles([])
+    p = Problem(scene=empty, start=[0.0, 0.0], goal=goal, waypoints=12, margin=0.02)
+    result = plan(p, collision="coal")
+    assert result.success and result.iterations == 0, result.reason
+    assert "repaired" not in result.reason and result.min_distance == np.inf
+    assert result.solve_time < 5.0  # not the 38 s of budgets run out

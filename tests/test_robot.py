@@ -94,3 +94,9 @@ def test_as_batch_promotes_single_configuration():
 def test_unknown_robot_names_choices():
     with pytest.raises(gp.UnknownNameError, match="planar7"):
         gp.load_robot("planar9")
+
+
+@pytest.mark.parametrize("n", [-1, 1.5, True, "3", None, 10**12])
+def test_sample_refuses_a_count_that_is_not_a_sane_integer(n):
+    with pytest.raises(gp.InputError, match="n:"):
+        gp.load_robot("planar2").sample(n)

@@ -320,3 +320,34 @@ def test_cell_bounds_hold_and_the_acceleration_bound_is_exact(seed, dof, n):
         assert np.all(np.abs(qd).max(0) <= vel[i] * (1 + 1e-9) + 1e-12)
         assert np.all(np.abs(qdd).max(0) <= acc[i] * (1 + 1e-9) + 1e-12)
         np.testing.assert_allclose(np.abs(qdd).max(0), acc[i], rtol=1e-3, atol=1e-9)
+
+
+# a path of planar2 in scene (a) certified with clearance ≥ 0.19 m whose PCHIP curve passes
+# 0.053 m from the square: the smooth timing must keep the plan's clearance, not only d > 0
+BULGING = np.array([[-2.065, -0.034], [-0.894, 2.086], [-0.193, 0.344]])
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 2**31), st.sampled_from([0.0, 0.5, 0.9]))
+@example(-1, 0.75)  # BULGING at clearance 0.15 m
+def test_the_executed_trajectory_keeps_the_plans_clearance(seed, share):
+    scene = gp.make_scene("a")
+    rng = np.random.default_rng(max(seed, 0))
+    q = BULGING if seed < 0 else rng.uniform(-3.0, 3.0, (3, 2))
+    cert = gp.certify_path(scene, q, margin=0.0)
+    if not cert.ok:
+        return
+    clearance = share * cert.lower_bound  # the polygon is certified with this clearance
+    traj = time_path(q, 1.0, 4.0, scene, clearance=clearance)
+    if traj.kind == "smooth":
+        assert traj.min_distance > clearance
+    _, qs = traj.sample(traj.duration / 2000)
+    assert np.min(signed_distance(scene, qs)) > clearance
+
+
+def test_plan_times_a_smooth_curve_only_at_its_clearance(square_plan):
+    scene = gp.make_scene("a")
+    traj, _ = plan_timing(scene, BULGING, True, 1.0, 4.0, clearance=0.15)
+    assert traj.kind == "stop"  # the curve dips to 0.053 m: the certified polygon instead
+    with pytest.raises(gp.InputError, match="clearance"):
+        time_path(BULGING, 1.0, 4.0, scene, clearance=-0.1)

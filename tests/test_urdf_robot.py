@@ -307,3 +307,222 @@ def test_arm_in_any_plane_is_accepted_and_a_tilted_plane_refused(rpy, lengths, t
         gp.robot_from_urdf(
             "arm", RobotSpec(urdf=path, planning_joints=("j1", "j2"), plane_axes=slight)
         )
+
+
+def mimic_arm(folder: Path) -> Path:
+    """j1 → j2 → j3 about z; j2 mimics j1 (a parallel linkage: j2 = 2 j1 + 0.1)."""
+    j2 = joint("j2", "l1", "l2", xyz="0.4 0 0").replace(
+        "</joint>", '<mimic joint="j1" multiplier="2" offset="0.1"/></joint>'
+    )
+    return write_urdf(
+        folder,
+        '<link name="base"/>',
+        joint("j1", "base", "l1"),
+        link("l1"),
+        j2,
+        link("l2"),
+        joint("j3", "l2", "l3", xyz="0.4 0 0"),
+        link("l3"),
+    )
+
+
+@pytest.mark.parametrize("planning", [("j1",), ("j2",), ("j1", "j2"), ("j1", "j2", "j3"), None])
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_a_planning_joint_in_a_mimic_pair_is_refused(tmp_path, planning, kind):
+    """Pinocchio reads a <mimic> joint as independent: planning either joint of the pair would
+    plan (and certify) another robot than the URDF's, so the loaders refuse it by name."""
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = mimic_arm(tmp_path)
+    with pytest.raises(InputError, match="'j2' mimics joint 'j1'"):
+        if kind == "planar":
+            spec = RobotSpec(urdf=path, planning_joints=planning or ("j1", "j2", "j3"))
+            robot_from_urdf("mimic_arm", spec)
+        else:
+            robot3d_from_urdf(path, joints=planning)
+
+
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_a_locked_mimic_pair_still_loads(tmp_path, kind):
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = mimic_arm(tmp_path)
+    if kind == "planar":
+        spec = RobotSpec(urdf=path, planning_joints=("j3",), locked={"j1": 0.2, "j2": 0.5})
+        assert robot_from_urdf("mimic_arm", spec).dof == 1
+    else:
+        assert robot3d_from_urdf(path, joints=["j3"], locked={"j1": 0.2, "j2": 0.5}).dof == 1
+
+
+@pytest.mark.parametrize("axis", ["0 0 0", "0 0 1e-300", "1e-200 1e-200 0", "0 0 -1e-310"])
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_a_joint_axis_that_is_no_direction_is_refused(tmp_path, axis, kind):
+    """Pinocchio keeps a zero axis (the joint never moves) and one too small to normalise (its
+    "rotations" scale and shear links): both loaders refuse them, naming the joint."""
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = two_link(tmp_path, axis2=axis)
+    with pytest.raises(InputError, match=r"joint 'j2' .* not a direction"):
+        if kind == "planar":
+            robot_from_urdf("axis_arm", RobotSpec(urdf=path, planning_joints=("j1", "j2")))
+        else:
+            robot3d_from_urdf(path)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3).filter(
+        lambda a: np.linalg.norm(a) > 1e-3
+    ),
+    st.sampled_from([1e-12, 1e-3, 1.0, 7.5, 1e9]),
+)
+def test_any_nonzero_joint_axis_acts_as_its_unit_direction(direction, scale):
+    """A 3-D arm's joint turns about axis / |axis| whatever the length the URDF gives."""
+    from gdnplan.arm3d import robot3d_from_urdf
+    from gdnplan.arm3d.fk3d import body_placements_batch
+
+    with tempfile.TemporaryDirectory() as folder:
+        axis = " ".join(repr(x * scale) for x in direction)
+        robot = robot3d_from_urdf(two_link(Path(folder), axis2=axis))
+    q = np.array([[0.3, 1.1]])
+    rotation = body_placements_batch(robot, q)[0, 2, :3, :3]
+    unit = np.asarray(direction) / np.linalg.norm(direction)
+    expected = (
+        pin.AngleAxis(0.3, np.array([0.0, 0.0, 1.0])).matrix() @ pin.AngleAxis(1.1, unit).matrix()
+    )
+    assert np.allclose(rotation, expected, atol=1e-9)
+
+
+def far_origins(folder: Path, out: str, back: str, collision: str = "0 0 0") -> Path:
+    """j1 about z, then fixed joints ``out`` and ``back`` along x, a box at ``collision``."""
+    box = f'<collision><origin xyz="{collision}"/><geometry><box size="0.1 0.1 0.1"/></geometry>'
+    return write_urdf(
+        folder,
+        '<link name="base"/>',
+        joint("j1", "base", "l1"),
+        '<link name="l1"/>',
+        joint("out", "l1", "l2", kind="fixed", xyz=f"{out} 0 0"),
+        '<link name="l2"/>',
+        joint("back", "l2", "l3", kind="fixed", xyz=f"{back} 0 0"),
+        f'<link name="l3">{box}</collision></link>',
+    )
+
+
+@pytest.mark.parametrize(
+    "out, back, collision",
+    [
+        ("1e20", "-99999999999999999999.4", "0 0 0"),  # the box is 0.6 m out; doubles say 0
+        ("1e300", "0", "0 0 0"),
+        ("0.3", "0.3", "0 0 1e300"),
+        ("1000.5", "-1000", "0 0 0"),
+    ],
+)
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+def test_an_origin_beyond_a_kilometre_is_refused(tmp_path, out, back, collision, kind):
+    """Far origins lose links' positions to rounding (or overflow coal): refused by name."""
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = far_origins(tmp_path, out, back, collision)
+    with pytest.raises(InputError, match=r"origin of .* beyond 1000 m"):
+        if kind == "planar":
+            robot_from_urdf("far_arm", RobotSpec(urdf=path, planning_joints=("j1",)))
+        else:
+            robot3d_from_urdf(path)
+
+
+def test_origins_within_a_kilometre_still_load(tmp_path):
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    robot = robot3d_from_urdf(far_origins(tmp_path, "999.5", "-999", "0 0 0.1"))
+    assert robot.dof == 1
+
+
+@pytest.mark.parametrize("kind", ["planar", "3d"])
+@pytest.mark.parametrize("j1", [-0.4, 0.0, 0.2, 1.3])
+def test_a_locked_mimic_follower_follows_its_master(tmp_path, kind, j1):
+    """Unlisted, j2 sits at 2 j1 + 0.1 (as on the real robot); listed elsewhere, refused."""
+    from gdnplan.arm3d import robot3d_from_urdf
+    from gdnplan.arm3d.fk3d import shape_placements_batch
+
+    path = mimic_arm(tmp_path)
+
+    def build(locked):
+        if kind == "planar":
+            spec = RobotSpec(urdf=path, planning_joints=("j3",), locked=locked)
+            return robot_from_urdf("mimic_arm", spec)
+        return robot3d_from_urdf(path, joints=["j3"], locked=locked)
+
+    follows, explicit = build({"j1": j1}), build({"j1": j1, "j2": 2 * j1 + 0.1})
+    q = np.array([[0.7]])
+    if kind == "planar":
+        assert np.allclose(follows.link_polygons(q[0])[-1], explicit.link_polygons(q[0])[-1])
+    else:
+        assert np.allclose(shape_placements_batch(follows, q), shape_placements_batch(explicit, q))
+    with pytest.raises(InputError, match="'j2' mimics 'j1'"):
+        build({"j1": j1, "j2": 2 * j1 + 0.2})
+
+
+def _dense_surface(kind: str, r: float, length: float, n: int = 400) -> np.ndarray:
+    """Dense points on a sphere, cylinder or capsule surface (its frame, axis z), (k, 3)."""
+    rng = np.random.default_rng(0)
+    u = rng.normal(size=(n, 3))
+    ball = r * u / np.linalg.norm(u, axis=1)[:, None]
+    a = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    ring = np.c_[r * np.cos(a), r * np.sin(a), np.zeros(n)]
+    if kind == "sphere":
+        return ball
+    ends = [ring + np.array([0.0, 0.0, z]) for z in (-length / 2, length / 2)]
+    if kind == "capsule":
+        ends += [ball + np.array([0.0, 0.0, z]) for z in (-length / 2, length / 2)]
+    return np.concatenate(ends)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    st.sampled_from(["sphere", "cylinder"]),
+    st.lists(st.floats(-3.1, 3.1), min_size=3, max_size=3),
+    st.floats(0.01, 0.3),
+    st.floats(0.01, 0.5),
+    st.integers(3, 16),
+)
+def test_a_link_polygon_contains_its_geometrys_projection(kind, rpy, r, length, most):
+    """Round URDF shapes at any orientation project inside their link polygon (a polygon
+    inscribed in the projection lost up to 15 % of a tilted sphere's radius: an obstacle in
+    that sliver was certified clear of the link)."""
+    size = f'radius="{r!r}"' if kind == "sphere" else f'radius="{r!r}" length="{length!r}"'
+    rpy_text = " ".join(repr(x) for x in rpy)
+    collision = (
+        f'<collision><origin xyz="0.5 0 0" rpy="{rpy_text}"/>'
+        f"<geometry><{kind} {size}/></geometry></collision>"
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        path = write_urdf(
+            Path(folder), '<link name="base"/>', joint("j1", "base", "l1"),
+            f'<link name="l1">{collision}</link>',
+        )  # fmt: skip
+        robot = robot_from_urdf("round_arm", RobotSpec(urdf=path, planning_joints=("j1",),
+                                                       max_vertices=most))  # fmt: skip
+    rotation = pin.rpy.rpyToMatrix(*rpy)
+    points = _dense_surface(kind, r, length) @ rotation.T + [0.5, 0.0, 0.0]
+    poly = robot.polygons[0].vertices0
+    edge = np.roll(poly, -1, 0) - poly
+    normal = np.c_[edge[:, 1], -edge[:, 0]] / np.linalg.norm(edge, axis=1)[:, None]
+    beyond = points[:, :2] @ normal.T - np.sum(poly * normal, axis=1)  # > 0: past an edge
+    assert np.max(beyond) <= 1e-9
+
+
+@pytest.mark.parametrize("kind", ["sphere", "cylinder", "capsule"])
+def test_geometry_points_span_a_hull_containing_the_shape(kind):
+    """geometry_points of round coal shapes: their 3-D hull contains the whole surface, so
+    every projection of it (any plane, any orientation) contains the shape's."""
+    import coal
+    from scipy.spatial import ConvexHull
+
+    from gdnplan.urdf_robot import geometry_points
+
+    r, length = 0.07, 0.3
+    shape = {"sphere": coal.Sphere(r), "cylinder": coal.Cylinder(r, length),
+             "capsule": coal.Capsule(r, length)}[kind]  # fmt: skip
+    faces = ConvexHull(geometry_points(shape)).equations  # n · x + c ≤ 0 inside
+    surface = _dense_surface(kind, r, length, n=2000)
+    assert np.max(surface @ faces[:, :3].T + faces[:, 3]) <= 1e-12

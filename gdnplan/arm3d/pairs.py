@@ -4,9 +4,11 @@ A pair of links (each carrying collision shapes) is checked unless
 
 * ``"same body"``: both move with the same planning joint (they are rigidly attached, e.g. a
   wrist, its flange and a locked gripper): their distance never changes;
-* ``"adjacent"``: one's body hangs directly from the other's by one planning joint. Adjacent
-  links meet at their joint, and their shapes (mesh hulls especially) touch or overlap there at
-  every configuration, so a check would report a collision that planning cannot remove;
+* ``"adjacent"``: the URDF joins the two links by one planning joint (and fixed joints only).
+  Adjacent links meet at their joint, and their shapes (mesh hulls especially) touch or overlap
+  there at every configuration, so a check would report a collision that planning cannot
+  remove. A locked joint on the way keeps a pair checked: with a UR5e's wrist joints locked the
+  gripper shares the forearm's body, yet it can fold into the upper arm;
 * the SRDF, when one is given, disables it (``<disable_collisions link1= link2= reason=/>``:
   MoveIt's "Adjacent", "Never", "Default", "Always"); the reason is kept.
 
@@ -73,7 +75,7 @@ def self_collision_pairs(
         key = frozenset((a, b))
         if ba == bb:
             disabled[key] = "same body"
-        elif reduced.parents[ba] == bb or reduced.parents[bb] == ba:
+        elif _adjacent(full, reduced, a, b, ba, bb):
             disabled[key] = "adjacent"
         elif key in disabled_srdf:
             disabled[key] = f"srdf: {disabled_srdf[key] or 'disabled'}"
@@ -84,6 +86,17 @@ def self_collision_pairs(
         and frozenset((shapes[i].link, shapes[j].link)) not in disabled
     ]
     return np.array(pairs, dtype=int).reshape(-1, 2), disabled
+
+
+def _adjacent(full: pin.Model, reduced: pin.Model, a: str, b: str, ba: int, bb: int) -> bool:
+    """Links a, b (on reduced bodies ba ≠ bb) are joined by one joint of the full model: the
+    planning joint between their bodies, with no locked joint on the way."""
+    if not (reduced.parents[ba] == bb or reduced.parents[bb] == ba):
+        return False
+    if not (full.existFrame(a) and full.existFrame(b)):
+        return True  # not URDF links (a held object): the bodies decide
+    ja, jb = (full.frames[full.getFrameId(link)].parentJoint for link in (a, b))
+    return full.parents[ja] == jb or full.parents[jb] == ja
 
 
 def checked_link_pairs(robot) -> set[frozenset[str]]:

@@ -28,7 +28,8 @@ import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
 from ..robot import as_batch
-from ..urdf_robot import RobotSpec, load_urdf
+from ..urdf_robot import CONTINUOUS, RobotSpec, load_urdf
+from ..urdf_robot.load import check_mimic, lock_mimics
 from .pairs import self_collision_pairs
 from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
 
@@ -194,7 +195,9 @@ def robot3d_from_urdf(
     if joints is None and any(model.joints[model.getJointId(j)].nq == 2 for j in planning):
         model, geom = load_urdf(RobotSpec(path, tuple(planning), package_dirs=dirs))
     _check_joints(model, planning, movable, path.name)
+    check_mimic(path, planning)
     q_ref = _locked_configuration(model, planning, locked or {}, path.name)
+    lock_mimics(model, q_ref, path, set(locked or {}))
     lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in planning]
     reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
     shapes = [_link_shape(reduced, obj) for obj in reduced_geom.geometryObjects]
@@ -236,8 +239,13 @@ def _locked_configuration(
         if not isinstance(jname, str) or not model.existJointName(jname) or jname in planning:
             raise UnknownNameError(f"locked: {jname!r} is not a non-planning joint of {source}")
         joint = model.joints[model.getJointId(jname)]
+        if not np.isfinite(value):
+            raise InputError(f"locked: {jname!r} needs a finite number, got {value!r}")
+        if joint.shortname() in CONTINUOUS:  # (cos θ, sin θ): any angle
+            q[joint.idx_q : joint.idx_q + 2] = np.cos(value), np.sin(value)
+            continue
         lo, hi = model.lowerPositionLimit[joint.idx_q], model.upperPositionLimit[joint.idx_q]
-        if joint.nq != 1 or not np.isfinite(value) or not lo - 1e-9 <= value <= hi + 1e-9:
+        if joint.nq != 1 or not lo - 1e-9 <= value <= hi + 1e-9:
             raise InputError(f"locked: {jname!r} = {value!r} is outside [{lo:.4g}, {hi:.4g}]")
         q[joint.idx_q] = value
     return q

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..limits import check_number
+from ..limits import is_number
 from ..ur5e.gripper import BODY_DEPTH, BODY_LENGTH, BODY_WIDTH, FINGER_LENGTH, GRASP_GAP, TCP
 from ..ur5e.layout import LIFT
 from .scene3d import Obstacle3D, box_obstacle
@@ -220,7 +220,10 @@ def random_placement(rng: np.random.Generator) -> Placement:
 
 def check_placement(x, y, yaw) -> Placement:
     """A placement from user numbers: finite x, y (m) and yaw (rad); InputError otherwise."""
-    values = [check_number(v, n, -np.inf) for v, n in ((x, "x"), (y, "y"), (yaw, "yaw"))]
+    if not all(is_number(v) and np.isfinite(v) for v in (x, y, yaw)):
+        shown = [v.item() if isinstance(v, np.generic) else v for v in (x, y, yaw)]
+        raise InputError(f"placement: expected finite x, y (m) and yaw (rad), got {shown}")
+    values = [float(x), float(y), float(yaw)]
     if np.hypot(values[0], values[1]) > 2.0:
         raise InputError(f"placement: ({x}, {y}) m is farther than 2 m from the robot")
     return Placement(*values)

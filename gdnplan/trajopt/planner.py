@@ -126,7 +126,7 @@ def plan(
         run = _plan_adam(problem, model, goal, cfg, seed, deadline)
     result = _finish(problem, run, t0)
     trajectory, note = plan_timing(
-        problem.scene, result.q, result.success, max_velocity, max_acceleration
+        problem.scene, result.q, result.success, max_velocity, max_acceleration, result.clearance
     )
     reason = f"{result.reason}; {note}".strip("; ") if note else result.reason
     return replace(result, trajectory=trajectory, reason=reason)

@@ -110,6 +110,8 @@ def repair(
     docstring); ``run`` takes its path when that is certified."""
     if not run.status or (run.verified is not None and run.verified.ok):
         return  # no solver path (no seed found), or one already certified
+    if run.seed is not None and run.seed.kind == "straight":
+        return  # the straight line, certified free at the margin: nothing to repair
     if time.perf_counter() >= deadline:
         return
     opt, ref = cfg.optimizer, cfg.refine

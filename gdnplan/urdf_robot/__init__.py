@@ -9,9 +9,11 @@ n = u × v). Every other joint is locked, and at q = 0 each planning joint must 
     x ↦ (u · (x − o₁), v · (x − o₁)),     o₁ = planning joint 1's world position at q = 0,
 
 move by the plane rotations of :class:`~gdnplan.robot.PlanarChain`. A collision geometry
-becomes one link polygon: the convex hull of its surface points (box corners, rings of
-cylinders and spheres, mesh vertices) in plane coordinates, simplified to at most
-``max_vertices`` vertices by dropping the vertex whose removal loses the least area.
+becomes one link polygon that contains its projection: the convex hull of points whose hull
+contains the shape (box corners, polygons circumscribing the circles of cylinders, polyhedra
+circumscribing spheres, mesh vertices) in plane coordinates, simplified to at most
+``max_vertices`` vertices by dropping the edge whose removal (its neighbours extended to
+meet) adds the least area, so the polygon only grows.
 Hand-made polygons (plane coordinates at q = 0) can replace or extend the projected ones.
 
 Modules: :mod:`~gdnplan.urdf_robot.spec` (:class:`RobotSpec`), :mod:`~gdnplan.urdf_robot.build`

@@ -10,6 +10,7 @@ import pinocchio as pin
 from ..errors import InputError, UnknownNameError
 from ..limits import is_number
 from ..robot import Plane, _joint_axis
+from .load import lock_mimics
 from .spec import RobotSpec
 
 AXIS_TOLERANCE = 1e-6  # largest sin(angle) between a planning joint's axis and the plane normal
@@ -103,6 +104,7 @@ def _reference_configuration(model: pin.Model, spec: RobotSpec, source: str) -> 
             q_ref[joint.idx_q : joint.idx_q + 2] = np.cos(value), np.sin(value)
         else:
             raise InputError(f"locked: joint {jname!r} has {joint.nq} coordinates, not one")
+    lock_mimics(model, q_ref, spec.urdf, set(spec.locked))
     return q_ref
 
 

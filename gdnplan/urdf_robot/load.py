@@ -15,13 +15,17 @@ import pinocchio as pin
 from ..errors import InputError, UnknownNameError
 from .spec import RobotSpec
 
+AXIS_UNIT_TOLERANCE = 1e-9  # largest | |axis| − 1 | of a joint axis after Pinocchio's parse
+MAX_OFFSET = 1e3  # m: largest |coordinate| of a joint origin or a collision origin
+
 
 def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     """Pinocchio model and collision geometry of ``spec.urdf``.
 
     Continuous planning joints become revolute joints limited to [−π, π] (Pinocchio gives a
     continuous joint two coordinates, cos θ and sin θ). UnknownNameError for a missing file;
-    InputError for one that does not parse, with the parser's first complaint.
+    InputError for one that does not parse, with the parser's first complaint, and for a
+    planning joint that is a ``<mimic>`` joint or is mimicked (:func:`check_mimic`).
     """
     path = Path(spec.urdf)
     try:
@@ -35,6 +39,8 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     except (OSError, ET.ParseError) as e:
         reason = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
+    _check_mimic(root, spec.planning_joints, path)
+    _check_origins(root, path)
     rewritten = False
     for joint in root.iter("joint"):
         if joint.get("type") == "continuous" and joint.get("name") in spec.planning_joints:
@@ -62,11 +68,121 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
         except (ValueError, RuntimeError) as e:
             error = e
         else:
+            _check_joint_axes(model, path)
             return model, geom
     reason = next((line.strip() for line in log if line.strip().startswith("Error:")), "")
     reason = (reason.removeprefix("Error:").strip() or str(error) or "no reason given").strip()
     reason = reason.splitlines()[0]
     raise InputError(f"urdf: {path} is not a valid URDF: {reason}") from error
+
+
+def _check_joint_axes(model: pin.Model, path: Path) -> None:
+    """InputError naming the first joint whose axis Pinocchio could not make a unit vector:
+    ``<axis xyz="0 0 0"/>`` or one so small its norm underflows (a zero axis never moves; a
+    non-unit one turns links by non-rotations, and no distance or certificate holds)."""
+    for j in range(1, model.njoints):
+        axis = getattr(model.joints[j].extract(), "axis", None)
+        if axis is None:
+            continue
+        norm = float(np.linalg.norm(np.asarray(axis, float)))
+        if not abs(norm - 1.0) <= AXIS_UNIT_TOLERANCE:
+            raise InputError(
+                f"urdf: joint {model.names[j]!r} of {path.name} has the axis "
+                f"{np.asarray(axis, float).tolist()}, not a direction; give a nonzero "
+                '<axis xyz="x y z"/>'
+            )
+
+
+def _check_origins(root: ET.Element, path: Path) -> None:
+    """InputError naming the first joint or collision ``<origin xyz>`` beyond ``MAX_OFFSET``
+    along an axis: there floating point loses a link's position (a fixed joint 1e20 m out and
+    one −99999999999999999999.4 m back put a link at 0, not 0.6 m) and coal's distances
+    overflow, so no certificate would describe the URDF's robot."""
+    owners = [(f"joint {j.get('name')!r}", j) for j in root.iter("joint")]
+    owners += [(f"a collision of link {k.get('name')!r}", c) for k in root.iter("link")
+               for c in k.iter("collision")]  # fmt: skip
+    for what, element in owners:
+        origin = element.find("origin")
+        text = "" if origin is None else origin.get("xyz", "")
+        try:
+            xyz = np.array([float(x) for x in text.split()])
+        except ValueError:
+            continue  # urdfdom names the malformed number
+        if not np.all(np.abs(xyz) <= MAX_OFFSET):
+            raise InputError(
+                f"urdf: the origin of {what} in {path.name} is {xyz.tolist()} m, beyond "
+                f"{MAX_OFFSET:g} m along an axis; use metres near the robot"
+            )
+
+
+def check_mimic(urdf: str | Path, planning) -> None:
+    """InputError when a planning joint of the URDF file is a ``<mimic>`` joint or mimicked.
+
+    Pinocchio reads a mimic joint as an independent joint, so gdnplan would plan it on its own
+    or hold it locked while its master moves: distances and certificates would be those of
+    another robot than the URDF describes."""
+    _check_mimic(ET.fromstring(Path(urdf).read_bytes()), planning, Path(urdf))
+
+
+def _check_mimic(root: ET.Element, planning, path: Path) -> None:
+    planned = set(planning or ())
+    for joint in root.iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is None:
+            continue
+        follower, master = joint.get("name"), mimic.get("joint")
+        if follower in planned or master in planned:
+            raise InputError(
+                f"joints: joint {follower!r} mimics joint {master!r} (<mimic> in {path.name}); "
+                "gdnplan moves planning joints independently and would not move them together: "
+                "lock both joints, or plan a URDF without the <mimic>"
+            )
+
+
+def mimic_relations(urdf: str | Path) -> dict[str, tuple[str, float, float]]:
+    """{follower: (master, multiplier, offset)} of the ``<mimic>`` joints of a URDF file
+    (follower = multiplier · master + offset); empty when the file cannot be read."""
+    try:
+        root = ET.fromstring(Path(urdf).read_bytes())
+    except (OSError, ValueError, ET.ParseError):
+        return {}
+    out = {}
+    for joint in root.iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is not None:
+            try:
+                factor = float(mimic.get("multiplier", 1.0))
+                offset = float(mimic.get("offset", 0.0))
+            except ValueError as e:
+                raise InputError(f"urdf: the <mimic> of joint {joint.get('name')!r}: {e}") from e
+            out[joint.get("name")] = (mimic.get("joint"), factor, offset)
+    return out
+
+
+def lock_mimics(model: pin.Model, q: np.ndarray, urdf: str | Path, given) -> None:
+    """Set every locked ``<mimic>`` follower of ``q`` (the full model's configuration, in
+    place) to multiplier · master + offset: unlisted followers take it, listed ones must equal
+    it (InputError otherwise: the URDF's robot would not be the one planned)."""
+    for follower, (master, factor, offset) in mimic_relations(urdf).items():
+        if not (model.existJointName(follower) and model.existJointName(master)):
+            continue
+        jf, jm = (model.joints[model.getJointId(n)] for n in (follower, master))
+        if jf.nq != 1 or jm.nq != 1:
+            continue
+        value = factor * q[jm.idx_q] + offset
+        if follower in given and abs(q[jf.idx_q] - value) > 1e-9 * (1 + abs(value)):
+            raise InputError(
+                f"locked: joint {follower!r} mimics {master!r} ({follower} = {factor:g} · "
+                f"{master} + {offset:g} = {value:.6g}) but is locked at {q[jf.idx_q]:.6g}; "
+                f"lock it at {value:.6g} or leave it out"
+            )
+        lo, hi = model.lowerPositionLimit[jf.idx_q], model.upperPositionLimit[jf.idx_q]
+        if not lo - 1e-9 <= value <= hi + 1e-9:
+            raise InputError(
+                f"locked: joint {follower!r} mimics {master!r} and would sit at {value:.6g}, "
+                f"outside its limits [{lo:.4g}, {hi:.4g}]; lock {master!r} elsewhere"
+            )
+        q[jf.idx_q] = value
 
 
 @contextlib.contextmanager
