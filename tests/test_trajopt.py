@@ -558,3 +558,12 @@ def test_old_solver_table_loads_into_the_new_configs_with_a_warning():
     with pytest.warns(FutureWarning):
         adam = Problem.from_config(_cfg(solver={"adam_lr": 0.02, "interpolated": 2}))
     assert adam.solver.optimizer == AdamConfig(lr=0.02, interpolated=2)
+
+
+@pytest.mark.parametrize("collision", ["coal", "distance_model"])
+def test_weights_with_a_model_that_loads_none_are_refused(square, collision):
+    """Weights beside collision='coal' (or a model instance) would be silently unused."""
+    problem = gp.Problem(square, np.array(START), np.array(GOAL))
+    model = CoalModel() if collision == "distance_model" else collision
+    with pytest.raises(gp.InputError, match="^weights: only collision='graphdistnet'"):
+        gp.plan(problem, collision=model, weights="b")

@@ -63,6 +63,8 @@ def run_fetch3d_command(
     model = "coal"
     if collision == "graphdistnet":
         model = learned_fetch_model(weights)
+    elif weights is not None:
+        raise InputError("--weights: only --collision graphdistnet loads weights")
     if write_problems is not None:
         from ..files import check_output_dir
 

@@ -44,8 +44,15 @@ def resolve_model(
     or a ``.safetensors`` path; None picks the shipped weights for a planar scene's robot and
     obstacles (:func:`gdnplan.assets.default_weights`); a 3-D scene has no default (the
     shipped 3-D weights are preliminary) and needs them named. The model refuses a scene it was
-    not trained for (its ``check_scene``).
+    not trained for (its ``check_scene``); weights with any other ``collision`` are refused
+    (they would be silently unused).
     """
+    if weights is not None and collision != "graphdistnet":
+        what = collision if isinstance(collision, str) else "a DistanceModel"
+        raise InputError(
+            f"weights: only collision='graphdistnet' loads weights, not {what!r}; drop the "
+            "weights (--weights) or use collision='graphdistnet'"
+        )
     if not isinstance(collision, str):
         if not isinstance(collision, DistanceModel):
             raise InputError(
