@@ -565,5 +565,5 @@ def test_weights_with_a_model_that_loads_none_are_refused(square, collision):
     """Weights beside collision='coal' (or a model instance) would be silently unused."""
     problem = gp.Problem(square, np.array(START), np.array(GOAL))
     model = CoalModel() if collision == "distance_model" else collision
-    with pytest.raises(gp.InputError, match="^weights: only collision='graphdistnet'"):
+    with pytest.raises(gp.InputError, match=r"^weights: only collision='graphdistnet'"):
         gp.plan(problem, collision=model, weights="b")
