@@ -222,7 +222,8 @@ def json_number(x: float) -> float | None:
 
 
 def plan_summary(result, joint_names: list[str]) -> dict:
-    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none;
+    """JSON-ready summary of a Plan (min_distance: the proven lower bound, null if none or
+    unbounded — nothing to collide with — which ``success`` tells apart;
     clearance: the clearance its certificate had to prove).
 
     ``t`` (s) is the time of each row of ``q`` (rad, columns in ``joint_names`` order), and
