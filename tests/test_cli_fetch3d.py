@@ -59,3 +59,34 @@ def test_the_canonical_3d_fetch_is_certified_and_writes_its_problems(tmp_path, c
     assert sorted(p.name for p in out.iterdir()) == sorted(f"fetch3d_{s}.toml" for s in PLANNED)
     for path in out.iterdir():
         assert Problem.from_toml(path).scene.robot.name == "ur5e"
+
+
+def test_the_shipped_fetch_weights_are_taken_by_name():
+    """``--weights ur5e_storage3d``: the shipped GraphDistNet-3D weights of the 3-D fetch load
+    by name and know both fetch scenes (fingers open, holding the stick)."""
+    from gdnplan.arm3d.fetch3d_scene import fetch3d
+    from gdnplan.cli.fetch3d import learned_fetch_model
+    from gdnplan.errors import InputError
+    from gdnplan.models import load_model
+
+    model = learned_fetch_model("ur5e_storage3d")
+    assert model.card["env"] == "ur5e_storage" and model.card["test"]["auc"] >= 0.99
+    fetch = fetch3d(1)
+    boxes = load_model("ur5e_boxes3d_preliminary")
+    for scene in fetch.scenes.values():
+        model.check_scene(scene)  # refuses (InputError) scenes unlike its training
+        with pytest.raises(InputError):
+            boxes.check_scene(scene)  # the random-boxes weights do not know the storage
+
+
+@pytest.mark.slow
+def test_the_3d_fetch_with_learned_constraints_is_certified(capsys):
+    from gdnplan.cli import run
+
+    args = ["fetch", "--3d", "--seed", "2", "--collision", "graphdistnet", "--weights",
+            "ur5e_storage3d", "--json", "-q"]  # fmt: skip
+    with pytest.raises(SystemExit) as exit_:
+        run(args)
+    assert exit_.value.code in (0, None)
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["success"] and all(s["success"] for s in summary["stages"])
