@@ -75,7 +75,7 @@ def main() -> None:
             table.add(env, name, f"{np.abs(d - f).mean():.4f}", f"{roc_auc(-d, f <= 0):.4f}")
         spread = draws.std(0)
         report.text(
-            f"**{env}** (random_pick = {model.config.random_pick}, n {len(f)}): AUC of single "
+            f"**{env}** (one random first-layer partner per graph, n {len(f)}): AUC of single "
             f"draws {np.mean(aucs):.4f} ± {np.std(aucs):.4f}; std of d̂ between draws "
             f"{spread.mean():.4f} m, within 5 cm of contact {spread[np.abs(f) < 0.05].mean():.4f} m"
         )

@@ -237,7 +237,7 @@ def network_line(card: dict) -> str:
     net, loss = split_config(flat)
     parts = [
         "soft nearest-node partners" if net.cross == "soft_knn" else
-        f"random (one per {net.random_pick}), then argmax partners",
+        "random (one per graph), then argmax partners",
         "two-way cross edges" if net.two_way else "one-way cross edges",
     ]  # fmt: skip
     if net.node_distance:

@@ -414,12 +414,10 @@ def test_config_keeps_the_architecture_and_refuses_removed_options_at_other_valu
         GraphDistNetConfig().with_(grad_weight=0.1)
 
 
-@pytest.mark.parametrize("pick", ["graph", "node"])
-def test_faithful_first_layer_picks_one_random_partner_per_graph(pick):
-    """§IV-A: "a single connection node per graph (j_{c,r}, j_{c,o})", randomly selected;
-    ``random_pick="node"`` (the weights trained before) draws one per node."""
+def test_faithful_first_layer_picks_one_random_partner_per_graph():
+    """§IV-A: "a single connection node per graph (j_{c,r}, j_{c,o})", randomly selected."""
     scene = gp.make_scene("d", seed=2)
-    net = GraphDistNet(GraphDistNetConfig.faithful(random_pick=pick, scale=scene.robot.reach))
+    net = GraphDistNet(GraphDistNetConfig.faithful(scale=scene.robot.reach))
     graph = robot_graph(scene.robot)
     obstacles = obstacle_graph(*scene_obstacles([scene]), None)
     nodes = torch.tensor(graph.positions_and_jacobians(scene.robot.sample(3, seed=0))[0])
@@ -432,5 +430,16 @@ def test_faithful_first_layer_picks_one_random_partner_per_graph(pick):
     distinct = [len(set(row[:n_r].tolist())) for row in idx] + [
         len(set(row[n_r:][g.mask[i, n_r:]].tolist())) for i, row in enumerate(idx)
     ]
-    assert max(distinct) == 1 if pick == "graph" else min(distinct) > 1
-    assert GraphDistNetConfig.from_dict({"cross": "argmax"}).random_pick == "node"  # old cards
+    assert max(distinct) == 1
+    assert len({int(row[0]) for row in idx}) > 1  # a new draw per sample
+
+
+def test_paper_architecture_cards_name_their_draw_and_old_per_node_cards_are_refused():
+    config = GraphDistNetConfig.faithful()
+    assert config.to_dict()["random_pick"] == "graph"
+    assert GraphDistNetConfig.from_dict(config.to_dict()) == config
+    assert "random_pick" not in GraphDistNetConfig().to_dict()  # soft partners draw nothing
+    with pytest.raises(gp.InputError, match=r"one per node.*retrain"):
+        GraphDistNetConfig.from_dict({"cross": "argmax"})  # cards before the per-graph draw
+    with pytest.raises(gp.InputError, match=r"random_pick = 'node'.*was removed"):
+        GraphDistNetConfig.from_dict({"cross": "argmax", "random_pick": "node"})

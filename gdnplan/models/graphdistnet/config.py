@@ -27,13 +27,10 @@ class GraphDistNetConfig:
         hidden: d_h, node feature size.
         mlp: hidden widths of each h_k.
         readout: hidden widths of the final MLP.
-        cross: ``"argmax"`` (paper: random, then argmax partner) or ``"soft_knn"``.
+        cross: ``"argmax"`` (the paper: at the first layer one random node j_c per graph,
+            the partner of every node of the other graph, §IV-A "a single connection node per
+            graph (j_{c,r}, j_{c,o})"; then the argmax partner) or ``"soft_knn"``.
         cross_k: candidates k of ``soft_knn`` (k + 1 nearest nodes are looked at).
-        random_pick: the first-layer partners of ``argmax``: ``"graph"`` (the paper: one
-            random node j_c per graph, the partner of every node of the other graph, §IV-A
-            "a single connection node per graph (j_{c,r}, j_{c,o})") or ``"node"`` (a random
-            partner per node: the weights trained before the paper's reading was fixed, whose
-            cards lack the field; ``from_dict`` loads them so).
         two_way: cross edges into both graphs (the paper). False: only robot nodes take a
             cross partner (obstacle nodes have z̄_i = z_i), so the obstacle features depend on
             the scene alone and inference computes them once per scene (package docstring).
@@ -63,7 +60,6 @@ class GraphDistNetConfig:
     readout: tuple[int, ...] = (32, 32, 32)
     cross: str = "soft_knn"
     cross_k: int = 4
-    random_pick: str = "graph"
     two_way: bool = True
     tau: float = 0.02
     node_distance: bool = False
@@ -81,8 +77,6 @@ class GraphDistNetConfig:
                 raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
         if self.cross not in ("argmax", "soft_knn"):
             raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
-        if self.random_pick not in ("graph", "node"):
-            raise InputError(f"random_pick: expected 'graph' or 'node', got {self.random_pick!r}")
         if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
             raise InputError("layers, hidden, cross_k and scale must be positive")
         if self.min_readout and not self.node_distance:
@@ -106,13 +100,22 @@ class GraphDistNetConfig:
         return cls(cross="soft_knn", **changes)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The card's ``config``; a paper-architecture card also names its first-layer draw
+        (``random_pick = "graph"``): cards without it drew a partner per node (refused)."""
+        out = asdict(self)
+        return out | {"random_pick": "graph"} if self.cross == "argmax" else out
 
     @classmethod
     def from_dict(cls, data: dict) -> GraphDistNetConfig:
         """The architecture of a card's ``config`` (module docstring: loss weights of old flat
         cards are skipped, removed options accepted at their former default only)."""
         data = {k: v for k, v in dict(data).items() if k not in LOSS_KEYS}
+        if data.get("cross") == "argmax" and "random_pick" not in data:
+            raise InputError(
+                "config: this paper-architecture card predates the paper's first layer (one "
+                "random partner per graph) and drew one per node, an option that was removed; "
+                "retrain it (gdnplan reproduce faithful)"
+            )
         for key, default in REMOVED.items():
             value = data.pop(key, default)
             if value != default:
@@ -120,8 +123,6 @@ class GraphDistNetConfig:
                     f"config: {key} = {value!r}: the option was removed (only its former "
                     f"default {default!r} is accepted); drop it from the config or retrain"
                 )
-        if data.get("cross") == "argmax":  # cards before random_pick drew a partner per node
-            data.setdefault("random_pick", "node")
         known = {f.name for f in fields(cls)}
         unknown = set(data) - known
         if unknown:
@@ -145,4 +146,4 @@ class GraphDistNetConfig:
 # Loss weights that old flat cards keep in their config (training settings now).
 LOSS_KEYS = ("grad_weight", "grad_norm_weight", "contact_weight", "contact_scale")
 # Removed options -> the one value they had in every card (accepted, and dropped).
-REMOVED = {"activation": "leaky_relu", "max_edge": None}
+REMOVED = {"activation": "leaky_relu", "max_edge": None, "random_pick": "graph"}

@@ -103,17 +103,15 @@ class GraphDistNet(LeanInference, nn.Module):
         self, g: Union, h: torch.Tensor | None, k: int, generator: torch.Generator | None
     ) -> torch.Tensor:
         """(B, N) paper partners: at k = 0 a random node of the other graph (one per graph,
-        the partner of all its nodes, or one per node: ``random_pick``), else the argmax of
-        a⁽ᵏ⁾ᵀ x⁽ᵏ⁾ in the other graph."""
+        the partner of all its nodes), else the argmax of a⁽ᵏ⁾ᵀ x⁽ᵏ⁾ in the other graph."""
         b, n = g.mask.shape
         n_r = g.n_robot
         valid_r = g.mask[:, :n_r].sum(1, keepdim=True)  # valid nodes come first in each graph
         valid_o = g.mask[:, n_r:].sum(1, keepdim=True)
         is_robot = torch.arange(n, device=g.mask.device) < n_r
-        if h is None:  # one draw per graph (the paper) or per node (random_pick="node")
-            per_graph = self.config.random_pick == "graph"
-            u = torch.rand(b, 2 if per_graph else n, generator=generator, device=g.mask.device)
-            u_o, u_r = (u[:, :1], u[:, 1:]) if per_graph else (u, u)
+        if h is None:  # one draw per graph (the paper)
+            u = torch.rand(b, 2, generator=generator, device=g.mask.device)
+            u_o, u_r = u[:, :1], u[:, 1:]
             pick_o = n_r + (u_o * valid_o).long().clamp_max(valid_o - 1)
             pick_r = (u_r * valid_r).long().clamp_max(valid_r - 1)
             return torch.where(is_robot, pick_o, pick_r).expand(b, n)
