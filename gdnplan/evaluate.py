@@ -295,9 +295,8 @@ Notes (how each number is made; `paper` columns are the paper's Table I):
   GraphDistNet (paper architecture, this implementation): `weights/<env>_faithful`, §IV as
   written (a random, then the argmax partner per graph, two-way cross edges, no node
   distances, the squared distance loss), trained on the same data for the same seconds as the
-  gdnplan row (`gdnplan reproduce faithful --env <env>`); weights with "one per node" below
-  predate the paper's one-partner-per-graph reading and trained on less (36 000 samples).
-  Both rows stand beside the paper's GraphDistNet numbers.
+  gdnplan row (`gdnplan reproduce faithful --env <env>`). Both rows stand beside the
+  paper's GraphDistNet numbers.
 - ClearanceNet: MLP 3×256 ReLU on [q/π, obstacle poses (centre, cos 4θ, sin 4θ) or padded
   α-shape vertices], dropout 0.5 for d and e, Adam on data/<env>/train (weights card: data,
   epochs, seconds); a 120 s training budget per environment on this CPU.

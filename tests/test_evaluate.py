@@ -100,12 +100,12 @@ def test_reproduce_table1_fast_writes_markdown(tmp_path):
 
 def test_network_line_names_the_architecture_and_loss():
     card = {
-        "config": {"cross": "argmax", "two_way": True},  # an old card: one pick per node
+        "config": {"cross": "argmax", "random_pick": "graph", "two_way": True},
         "training": {"loss": {"grad_weight": 0.1}, "seconds": 12.0},
         "data": {"n_train": 36000, "extra": {}},
     }
     line = ev.network_line(card)
-    assert line.startswith("random (one per node), then argmax partners, two-way cross edges;")
+    assert line.startswith("random (one per graph), then argmax partners, two-way cross edges;")
     assert "loss: distance + gradient λ = 0.1; 36 000 training samples; 12 s" in line
 
 
