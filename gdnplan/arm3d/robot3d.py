@@ -28,8 +28,9 @@ import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
 from ..robot import as_batch
-from ..urdf_robot import CONTINUOUS, RobotSpec, load_urdf
-from ..urdf_robot.load import check_mimic, lock_mimics
+from ..urdf_robot import RobotSpec, load_urdf
+from ..urdf_robot.load import check_mimic
+from ..urdf_robot.locking import lock_mimics, set_locked
 from .pairs import self_collision_pairs
 from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
 
@@ -238,16 +239,7 @@ def _locked_configuration(
     for jname, value in locked.items():
         if not isinstance(jname, str) or not model.existJointName(jname) or jname in planning:
             raise UnknownNameError(f"locked: {jname!r} is not a non-planning joint of {source}")
-        joint = model.joints[model.getJointId(jname)]
-        if not np.isfinite(value):
-            raise InputError(f"locked: {jname!r} needs a finite number, got {value!r}")
-        if joint.shortname() in CONTINUOUS:  # (cos θ, sin θ): any angle
-            q[joint.idx_q : joint.idx_q + 2] = np.cos(value), np.sin(value)
-            continue
-        lo, hi = model.lowerPositionLimit[joint.idx_q], model.upperPositionLimit[joint.idx_q]
-        if joint.nq != 1 or not lo - 1e-9 <= value <= hi + 1e-9:
-            raise InputError(f"locked: {jname!r} = {value!r} is outside [{lo:.4g}, {hi:.4g}]")
-        q[joint.idx_q] = value
+        set_locked(model, q, jname, value)
     return q
 
 

@@ -18,7 +18,8 @@ Hand-made polygons (plane coordinates at q = 0) can replace or extend the projec
 
 Modules: :mod:`~gdnplan.urdf_robot.spec` (:class:`RobotSpec`), :mod:`~gdnplan.urdf_robot.build`
 (the robot from a URDF or from built models), :mod:`~gdnplan.urdf_robot.checks` (plane axes,
-planning joints, locked values), :mod:`~gdnplan.urdf_robot.load` (URDF parsing with readable
+planning joints), :mod:`~gdnplan.urdf_robot.locking` (locked values and ``<mimic>`` followers,
+shared with the 3-D loader), :mod:`~gdnplan.urdf_robot.load` (URDF parsing with readable
 errors) and :mod:`~gdnplan.urdf_robot.shapes` (collision shapes → projected link polygons).
 Every public name is re-exported here.
 """
@@ -26,8 +27,9 @@ Every public name is re-exported here.
 from __future__ import annotations
 
 from .build import robot_from_models, robot_from_urdf
-from .checks import AXIS_TOLERANCE, CONTINUOUS, JOINT_KINDS, PLANE_TOLERANCE, REVOLUTE, plane_basis
+from .checks import AXIS_TOLERANCE, JOINT_KINDS, PLANE_TOLERANCE, REVOLUTE, plane_basis
 from .load import load_urdf
+from .locking import CONTINUOUS
 from .shapes import geometry_points
 from .spec import RobotSpec
 

@@ -10,13 +10,12 @@ import pinocchio as pin
 from ..errors import InputError, UnknownNameError
 from ..limits import is_number
 from ..robot import Plane, _joint_axis
-from .load import lock_mimics
+from .locking import CONTINUOUS, lock_mimics, set_locked
 from .spec import RobotSpec
 
 AXIS_TOLERANCE = 1e-6  # largest sin(angle) between a planning joint's axis and the plane normal
 PLANE_TOLERANCE = 1e-3  # largest |cos(angle)| between the given plane axes u and v
 REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
-CONTINUOUS = {"JointModelRUBX", "JointModelRUBY", "JointModelRUBZ"}
 JOINT_KINDS = {"P": "prismatic", "RUB": "continuous", "FreeFlyer": "floating", "Planar": "planar"}
 
 
@@ -89,21 +88,7 @@ def _reference_configuration(model: pin.Model, spec: RobotSpec, source: str) -> 
             )
         if jname in planning:
             raise InputError(f"locked: joint {jname!r} is a planning joint; lock it or plan it")
-        if not is_number(value) or not np.isfinite(value):
-            raise InputError(f"locked: joint {jname!r} needs a finite number, got {value!r}")
-        joint = model.joints[model.getJointId(jname)]
-        if joint.nq == 1:
-            lo, hi = model.lowerPositionLimit[joint.idx_q], model.upperPositionLimit[joint.idx_q]
-            if not lo - 1e-9 <= value <= hi + 1e-9:
-                raise InputError(
-                    f"locked: joint {jname!r} = {value:.4g} is outside its limits "
-                    f"[{lo:.4g}, {hi:.4g}]"
-                )
-            q_ref[joint.idx_q] = value
-        elif joint.shortname() in CONTINUOUS:
-            q_ref[joint.idx_q : joint.idx_q + 2] = np.cos(value), np.sin(value)
-        else:
-            raise InputError(f"locked: joint {jname!r} has {joint.nq} coordinates, not one")
+        set_locked(model, q_ref, jname, value)
     lock_mimics(model, q_ref, spec.urdf, set(spec.locked))
     return q_ref
 

@@ -139,52 +139,6 @@ def _check_mimic(root: ET.Element, planning, path: Path) -> None:
             )
 
 
-def mimic_relations(urdf: str | Path) -> dict[str, tuple[str, float, float]]:
-    """{follower: (master, multiplier, offset)} of the ``<mimic>`` joints of a URDF file
-    (follower = multiplier · master + offset); empty when the file cannot be read."""
-    try:
-        root = ET.fromstring(Path(urdf).read_bytes())
-    except (OSError, ValueError, ET.ParseError):
-        return {}
-    out = {}
-    for joint in root.iter("joint"):
-        mimic = joint.find("mimic")
-        if mimic is not None:
-            try:
-                factor = float(mimic.get("multiplier", 1.0))
-                offset = float(mimic.get("offset", 0.0))
-            except ValueError as e:
-                raise InputError(f"urdf: the <mimic> of joint {joint.get('name')!r}: {e}") from e
-            out[joint.get("name")] = (mimic.get("joint"), factor, offset)
-    return out
-
-
-def lock_mimics(model: pin.Model, q: np.ndarray, urdf: str | Path, given) -> None:
-    """Set every locked ``<mimic>`` follower of ``q`` (the full model's configuration, in
-    place) to multiplier · master + offset: unlisted followers take it, listed ones must equal
-    it (InputError otherwise: the URDF's robot would not be the one planned)."""
-    for follower, (master, factor, offset) in mimic_relations(urdf).items():
-        if not (model.existJointName(follower) and model.existJointName(master)):
-            continue
-        jf, jm = (model.joints[model.getJointId(n)] for n in (follower, master))
-        if jf.nq != 1 or jm.nq != 1:
-            continue
-        value = factor * q[jm.idx_q] + offset
-        if follower in given and abs(q[jf.idx_q] - value) > 1e-9 * (1 + abs(value)):
-            raise InputError(
-                f"locked: joint {follower!r} mimics {master!r} ({follower} = {factor:g} · "
-                f"{master} + {offset:g} = {value:.6g}) but is locked at {q[jf.idx_q]:.6g}; "
-                f"lock it at {value:.6g} or leave it out"
-            )
-        lo, hi = model.lowerPositionLimit[jf.idx_q], model.upperPositionLimit[jf.idx_q]
-        if not lo - 1e-9 <= value <= hi + 1e-9:
-            raise InputError(
-                f"locked: joint {follower!r} mimics {master!r} and would sit at {value:.6g}, "
-                f"outside its limits [{lo:.4g}, {hi:.4g}]; lock {master!r} elsewhere"
-            )
-        q[jf.idx_q] = value
-
-
 @contextlib.contextmanager
 def _stderr_captured() -> Iterator[list[str]]:
     """Collect what C++ code (urdfdom) writes to file descriptor 2 into a list of lines."""
