@@ -54,7 +54,7 @@ def looks_like_path(ref: str | Path) -> bool:
 
 
 def _check_ref(ref, what: str) -> None:
-    """InputError unless ``ref`` is a name (str) or a path (os.PathLike)."""
+    """InputError unless ``ref`` is a name (str) or a path (pathlib.Path)."""
     if not isinstance(ref, (str, Path)):
         raise InputError(
             f"{what}: expected a shipped {what} name or a file path, got {type(ref).__name__}"

@@ -43,7 +43,6 @@ def test_reach_in_with_graphdistnet_end_to_end_is_certified_by_coal():
     problem = gp.Problem.from_toml(ROOT / "problems" / "fetch_reach.toml")
     result = gp.plan(problem, collision="graphdistnet")  # weights/ur5e via the scene name
     assert result.success, result.reason
-    assert result.solve_time < 120
     ok, dmin = gp.verify_path(problem.scene, result.q)
     assert ok and dmin > 0
     np.testing.assert_allclose(result.q[0], problem.start)
