@@ -233,14 +233,14 @@ def run(
     s = s or Settings()
     data_root, runs = Path(data_root), Path(runs)
     deadline = time.monotonic() + train_for
-    out: dict[str, list[list[dict]]] = {}
     for env in envs:
         if train_for > 0 and not split_dir(env, "train", data_root).is_dir():
             raise FileNotFoundError(f"{split_dir(env, 'train', data_root)}: generate it first")
-        out[env] = []
-        for step in range(len(STEPS)):
-            per_seed = []
-            for seed in range(seeds):
+    # Seed-major: one seed of every environment and step before the next seed, so a partial
+    # run already has a whole (single-seed) table.
+    for seed in range(seeds):
+        for env in envs:
+            for step in range(len(STEPS)):
                 weights = _weights_path(runs, env, step, seed)
                 if not weights.exists() and time.monotonic() >= deadline:
                     continue
@@ -248,10 +248,16 @@ def run(
                 cached = weights.with_suffix(".scores.json")
                 if not cached.exists():
                     cached.write_text(json.dumps(score(weights, env, s), indent=1) + "\n")
-                per_seed.append(json.loads(cached.read_text()))
-                log(f"ablation {env} {STEPS[step][0]} seed {seed}: {per_seed[-1]}")
-            out[env].append(per_seed)
-    return out
+                log(f"ablation {env} {STEPS[step][0]} seed {seed}: {cached.read_text()}")
+    return {env: [_kept_scores(runs, env, step, seeds) for step in range(len(STEPS))]
+            for env in envs}  # fmt: skip
+
+
+def _kept_scores(runs: Path, env: str, step: int, seeds: int) -> list[dict]:
+    """The scores of ``STEPS[step]`` of every seed trained so far."""
+    paths = (_weights_path(runs, env, step, seed).with_suffix(".scores.json")
+             for seed in range(seeds))  # fmt: skip
+    return [json.loads(p.read_text()) for p in paths if p.exists()]
 
 
 def _mean_se(values: list[float], fmt: str) -> str:
