@@ -81,6 +81,8 @@ def _tile(n: int) -> int:
 
 
 if AVAILABLE:
+    from .gemm import mm
+
     _jit = numba.njit(cache=True, fastmath=True, nogil=True)
 
     @_jit
@@ -149,7 +151,7 @@ if AVAILABLE:
             r0 = b0 * 3 * n
             _leaky_rows(a, empty, masks[0, r0 : r0 + rows] if keep else nomask, slope)
             for layer in range(layers):
-                a = np.dot(a, wt[layer])
+                a = mm(a, wt[layer])
                 m = masks[layer + 1, r0 : r0 + rows] if keep else nomask
                 _leaky_rows(a, b[layer], m, slope)
             for t in range(nb):
@@ -181,7 +183,7 @@ if AVAILABLE:
                             x = grad[b0 + t, i, o]
                             a[r, o] = x if top[r, o] else x * slope
             for layer in range(layers - 1, -1, -1):
-                a = np.dot(a, w[layer])
+                a = mm(a, w[layer])
                 m = masks[layer, r0 : r0 + rows]
                 for r in range(rows):
                     for o in range(h):

@@ -14,6 +14,7 @@ from .fused import AVAILABLE
 
 if AVAILABLE:
     from .fused import _jit, _log_phi_backward
+    from .gemm import mm
 
     @_jit
     def _head_backward(net, st, t_n):
@@ -26,12 +27,12 @@ if AVAILABLE:
                 gv = net.wlast[o] * net.scale
                 g[t, o] = gv if st.hmask[hl, t, o] else gv * net.slope
         for layer in range(hl - 1, -1, -1):
-            g = np.dot(g, net.hw[layer])
+            g = mm(g, net.hw[layer])
             for t in range(t_n):
                 for o in range(r):
                     if not st.hmask[layer, t, o]:
                         g[t, o] *= net.slope
-        return np.dot(g, net.h0)
+        return mm(g, net.h0)
 
     @_jit
     def _readout_backward(net, st, k, t_n, n_r, dy, dh):
@@ -72,7 +73,7 @@ if AVAILABLE:
         h = net.att.shape[1]
         rows = t_n * n
         slope = net.slope
-        dmsg = np.dot(dh, net.wl[k])
+        dmsg = mm(dh, net.wl[k])
         a = np.empty((3 * rows, h), dh.dtype)
         top = st.mask[k, st.mask.shape[1] - 1]
         for t in range(t_n):
@@ -84,7 +85,7 @@ if AVAILABLE:
                         gv = dmsg[t * n + i, o]
                         a[r, o] = gv if top[r, o] else gv * slope
         for layer in range(net.wh.shape[1] - 1, -1, -1):
-            a = np.dot(a, net.wh[k, layer])
+            a = mm(a, net.wh[k, layer])
             m = st.mask[k, layer]
             for r in range(3 * rows):
                 for o in range(h):  # a select, not a branch: vectorised
@@ -182,7 +183,7 @@ if AVAILABLE:
                             acc += duv[t * n + i, o] * net.ax[k, j, o]
                         g_out[t, i, j] += acc
             if k:
-                dh = np.dot(duv, net.aht[k])
+                dh = mm(duv, net.aht[k])
                 if two_way:  # the partner scores s = a_{k−1}ᵀ h⁽ᵏ⁻¹⁾
                     for r in range(rows):
                         for o in range(h):

@@ -45,6 +45,7 @@ signs of the head's pre-activations."""
 if AVAILABLE:
     from .fused import _jit, _leaky_rows, _softmax_inplace
     from .fused_net_backward import _backward_tile
+    from .gemm import mm
 
     @_jit
     def _nearest(p0, p1, partners, offset, idx, near, lphi):
@@ -114,7 +115,7 @@ if AVAILABLE:
         h = net.att.shape[1]
         rows = t_n * n
         dtype = st.xu.dtype
-        uv = np.dot(st.h[k - 1, :rows], net.ah[k]) if k else np.zeros((rows, 2 * h), dtype)
+        uv = mm(st.h[k - 1, :rows], net.ah[k]) if k else np.zeros((rows, 2 * h), dtype)
         for t in range(t_n):
             for i in range(n):
                 r = t * n + i
@@ -158,7 +159,7 @@ if AVAILABLE:
                     a[base + 2 * n + i, o] = cc[r, o]
         _leaky_rows(a, np.empty(0, a.dtype), st.mask[k, 0], net.slope)
         for layer in range(net.wht.shape[1]):
-            a = np.dot(a, net.wht[k, layer])
+            a = mm(a, net.wht[k, layer])
             _leaky_rows(a, net.bh[k, layer], st.mask[k, layer + 1], net.slope)
         msg = np.empty((rows, h), a.dtype)
         for t in range(t_n):
@@ -168,7 +169,7 @@ if AVAILABLE:
                 for o in range(h):
                     msg[t * n + i, o] = a[r, o] + a[r + n, o] + a[r + 2 * n, o]
         hk = st.h[k, :rows]
-        hk[:] = np.dot(msg, net.wlt[k])
+        hk[:] = mm(msg, net.wlt[k])
         for r in range(rows):
             for o in range(h):
                 hk[r, o] += net.bl3[k, o]
@@ -228,10 +229,10 @@ if AVAILABLE:
             uv, cc = _node_terms(net, st, k, t_n, two_way)
             _edge_mlp(net, st, k, t_n, uv, cc)
             _readout(net, st, k, t_n, n_r, pooled)
-        a = np.dot(pooled, net.h0t)  # the head (one-way: its obstacle half is in hb0)
+        a = mm(pooled, net.h0t)  # the head (one-way: its obstacle half is in hb0)
         _leaky_rows(a, net.hb0, st.hmask[0], net.slope)
         for layer in range(net.hwt.shape[0]):
-            a = np.dot(a, net.hwt[layer])
+            a = mm(a, net.hwt[layer])
             _leaky_rows(a, net.hb[layer], st.hmask[layer + 1], net.slope)
         for t in range(t_n):
             out = net.blast[0]

@@ -13,6 +13,7 @@ from ..graphdistnet.fused import AVAILABLE
 
 if AVAILABLE:
     from ..graphdistnet.fused import _jit, _log_phi_backward
+    from ..graphdistnet.gemm import mm
 
     @_jit
     def _head_backward(wts, st, t_n, scale, slope):
@@ -25,12 +26,12 @@ if AVAILABLE:
                 gv = wts.wlast[o] * scale
                 g[t, o] = gv if st.hmask[hl, t, o] else gv * slope
         for layer in range(hl - 1, -1, -1):
-            g = np.dot(g, wts.hw[layer])
+            g = mm(g, wts.hw[layer])
             for t in range(t_n):
                 for o in range(r):
                     if not st.hmask[layer, t, o]:
                         g[t, o] *= slope
-        return np.dot(g, wts.h0)
+        return mm(g, wts.h0)
 
     @_jit
     def _readout_backward(k, dy, wts, st, dh, slope):
@@ -69,7 +70,7 @@ if AVAILABLE:
         n_e = graph.src.shape[0]
         per = n_e + n
         p = wts.b1.shape[1]
-        dmsg = np.dot(dh, wts.wl[k])  # (T n, P)
+        dmsg = mm(dh, wts.wl[k])  # (T n, P)
         a = np.empty((t_n * per, p), dh.dtype)
         top = st.mask[k, st.mask.shape[1] - 1]
         for t in range(t_n):
@@ -86,7 +87,7 @@ if AVAILABLE:
                     gv = dmsg[off + i, o]
                     a[r, o] = gv if top[r, o] else gv * slope
         for layer in range(wts.wh.shape[1] - 1, -1, -1):
-            a = np.dot(a, wts.wh[k, layer])
+            a = mm(a, wts.wh[k, layer])
             m = st.mask[k, layer]
             for r in range(a.shape[0]):
                 for o in range(p):
@@ -144,7 +145,7 @@ if AVAILABLE:
                             acc += duv[r, o] * wts.ax[k, d, o]
                         g_out[t, i, d] += acc
             if k:
-                dh = np.dot(duv, wts.aht[k])
+                dh = mm(duv, wts.aht[k])
         for t in range(t_n):  # log φ, then d² = |x − x_o|²
             for i in range(n):
                 _log_phi_backward(st.near[t, i], dlphi[t, i], dnear[t, i], cand)

@@ -83,6 +83,7 @@ class State(NamedTuple):
 
 if AVAILABLE:
     from ..graphdistnet.fused import _jit, _leaky_rows, _softmax_inplace
+    from ..graphdistnet.gemm import mm
     from .fused3d_backward import _backward_tile
 
     @_jit
@@ -182,7 +183,7 @@ if AVAILABLE:
             _soft_weights(k, t_n, wts, st)
             w = st.w[k]
             if k:  # [u v] = z A_k: the h part by BLAS, the three coordinates as loops
-                uv = np.dot(st.h[k - 1, :rows], wts.ah[k])
+                uv = mm(st.h[k - 1, :rows], wts.ah[k])
             else:
                 uv = np.zeros((rows, 2 * p), x.dtype)
             cc = np.empty((rows, p), x.dtype)  # c_i = Σ_c w_ic V_k,j_c − v_i + b_k
@@ -221,7 +222,7 @@ if AVAILABLE:
                         if keep:
                             m0[base + n_e + i, o] = s > 0
             for layer in range(wts.wht.shape[1]):
-                a = np.dot(a, wts.wht[k, layer])
+                a = mm(a, wts.wht[k, layer])
                 m = st.mask[k, layer + 1, :e_rows] if keep else nomask
                 _leaky_rows(a, wts.bh[k, layer], m, slope)
             msg = np.empty((rows, p), x.dtype)  # Σ over node i's edges and itself
@@ -234,16 +235,16 @@ if AVAILABLE:
                         for o in range(p):
                             msg[t * n + i, o] += a[base + e, o]
             hk = st.h[k, :rows]
-            hk[:] = np.dot(msg, wts.wlt[k])
+            hk[:] = mm(msg, wts.wlt[k])
             for t in range(t_n):
                 for i in range(n):
                     for o in range(h):
                         hk[t * n + i, o] += graph.cnt[i] * wts.bl[k, o]
             _readout(k, hk, wts, st, pooled, slope)
-        a = np.dot(pooled, wts.h0t)  # the head (its obstacle half is in hb0)
+        a = mm(pooled, wts.h0t)  # the head (its obstacle half is in hb0)
         _leaky_rows(a, wts.hb0, st.hmask[0, :t_n], slope)
         for layer in range(wts.hwt.shape[0]):
-            a = np.dot(a, wts.hwt[layer])
+            a = mm(a, wts.hwt[layer])
             _leaky_rows(a, wts.hb[layer], st.hmask[layer + 1, :t_n], slope)
         for t in range(t_n):
             out = wts.blast[0]
