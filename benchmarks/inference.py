@@ -14,6 +14,8 @@ after one warm-up call each, all six interleaved round by round.
 FLOPs: the matmul FLOPs torch runs (FlopCounterMode) plus the fused kernels' products (2 R H²
 per hidden layer of the edge MLP on R edge rows, forward and backward; 2 n C H for the sparse
 cross mix; :func:`network_flops` for the whole-network pass), counted by wrapping them.
+The last column puts both on one core: coal's distance + gradient of the same batch in this
+process (no forked workers), thread CPU s, against the fused pass's thread CPU s.
 Reported: GFLOP/s of the fused kernels alone
 (their FLOPs over their thread CPU seconds) and of the whole fused distance + gradient pass
 (all its FLOPs over its best thread CPU seconds), each as a share of a 2048² float32 matmul
@@ -104,6 +106,12 @@ def metered(call: Callable[[], object]) -> tuple[int, int, float]:
     return counter.get_total_flops(), kernel["flops"], kernel["seconds"]
 
 
+def coal_one_core(scene, q) -> None:
+    """Coal's distance and exact gradient of the batch in this process (no forked workers)."""
+    w = distance.checker(scene).closest(q, per_link=False)
+    distance.witness_gradient(scene, q, w)
+
+
 def row(table: common.Table, env: str, n: int, repeats: int, peak: float) -> None:
     """One table row: seconds of coal and both GraphDistNet paths for n configurations."""
     scene = gp.make_scene(env, seed=0)
@@ -123,6 +131,7 @@ def row(table: common.Table, env: str, n: int, repeats: int, peak: float) -> Non
     t = {key: timing.best for key, timing in common.time_calls(calls, repeats).items()}
     torch_flops, kernel_flops, kernel_seconds = metered(calls["fused d+grad"])
     pass_cpu = cpu_seconds(calls["fused d+grad"], repeats)
+    coal_cpu = cpu_seconds(lambda: coal_one_core(scene, q), repeats)
     kernel_gflops = kernel_flops / kernel_seconds / 1e9
     pass_gflops = (torch_flops + kernel_flops) / pass_cpu / 1e9
     table.add(
@@ -133,6 +142,7 @@ def row(table: common.Table, env: str, n: int, repeats: int, peak: float) -> Non
         f"{t['fused d+grad'] / t['ref d+grad']:.2f}×",
         f"{kernel_gflops:.1f} ({100 * kernel_gflops / peak:.0f} %)",
         f"{pass_gflops:.1f} ({100 * pass_gflops / peak:.0f} %), {pass_cpu:.3f} s",
+        f"{coal_cpu:.3f} s, {pass_cpu / coal_cpu:.2f}×",
     )
 
 
@@ -163,6 +173,7 @@ def main() -> None:
         "fused/ref d+grad",
         "fused kernels GFLOP/s (share of peak)",
         "fused d+grad pass GFLOP/s (share), CPU s",
+        "coal d+grad on one core, CPU s; fused pass / it",
     )
     for env in args.envs:
         row(table, env, args.n, args.repeats, peak)

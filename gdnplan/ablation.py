@@ -2,7 +2,8 @@
 
 :data:`STEPS` starts at the paper's network (§IV, :meth:`GraphDistNetConfig.faithful`) and
 each step changes one architecture field of the step before; every step is trained with the
-same data, time budget, seeds and loss (the paper's: the squared distance error, no gradient
+same data, time budget (CPU seconds of the training process: the same work however busy
+the shared machine is), seeds and loss (the paper's: the squared distance error, no gradient
 or contact terms) and scored on the same held-out samples:
 
 * MAE (m), AUC and ACD on the test split (the card's, :func:`gdnplan.train.report.evaluate`),
@@ -208,7 +209,8 @@ def train_step(env: str, step: int, seed: int, s: Settings, data_root: Path, run
     if out.exists():
         return out
     best = BEST[env]
-    fit = FitConfig(batch=s.batch, epochs=s.epochs, patience=40, time_budget=s.budget, seed=seed)
+    fit = FitConfig(batch=s.batch, epochs=s.epochs, patience=40, time_budget=s.budget, seed=seed,
+                    budget_clock="cpu")  # fmt: skip
     config = TrainConfig(step_config(step), GraphDistNetLoss(), fit, best.n_train,
                          _extra(env, data_root))  # fmt: skip
     train(env, config, name, data_root=data_root, out=out, run_dir=runs / env / name)
@@ -298,11 +300,12 @@ def notes(s: Settings, n_test: str) -> str:
     return f"""
 Notes: each step changes one field of the step above (`gdnplan.ablation.STEPS`). Every step
 is trained from scratch on the same data (`data/<env>/train`, the shipped weights' share of
-it) for the same {s.budget:g} s of training (the epochs' own time on this shared CPU; early
-stopping after 40 epochs without a better validation MAE), with the paper's loss (squared
-distance error only) and the same seeds; ± is the standard error over the seeds. MAE, AUC,
-ACD: the {n_test} samples of `data/<env>/test` (seed 1). d̂+∇: one batch of
-{s.timing_batch} configurations of one scene, fastest of 3, one thread. Sweep max: the
+it) for the same {s.budget:g} s of training (the epochs' CPU time on one torch thread: the
+same work whatever else ran on the shared machine; early stopping after 40 epochs without
+a better validation MAE), with the paper's loss (squared distance error only) and the same
+seeds; ± is the standard error over the seeds. MAE, AUC, ACD: the {n_test} samples of
+`data/<env>/test` (seed 1). d̂+∇: one batch of {s.timing_batch} configurations of one scene,
+fastest of 3, one thread. Sweep max: the
 largest change of d̂ between 0.003 rad steps along {s.sweep_steps}-step sweeps of every joint
 from {s.sweeps} configuration(s), the largest over the seeds. Table II: Ipopt on the
 environment's own reaching problems (b and d only), certified successes over all seeds and

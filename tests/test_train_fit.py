@@ -2,6 +2,8 @@
 replaced, bit for bit, for both learned models; and its schedule's checks."""
 
 import math
+import sys
+import time
 from functools import cache
 
 import numpy as np
@@ -114,6 +116,27 @@ def test_fit_stops_at_the_time_budget_and_keeps_the_starting_weights_when_asked(
     assert state["best"] == state["init_val"]["val_score"]
 
 
+def test_the_cpu_clock_counts_this_process_s_cpu_time_not_the_time_spent_waiting(monkeypatch):
+    """An epoch that sleeps 0.3 s (a busy machine) costs the wall clock its sleep and the CPU
+    clock nearly nothing: with a 0.2 s budget the wall run stops after one epoch, the CPU run
+    goes on."""
+    fit_module = sys.modules["gdnplan.train.fit"]  # (gdnplan.train.fit is also the function)
+    real = fit_module._epoch
+
+    def waiting(*args):
+        time.sleep(0.3)
+        return real(*args)
+
+    monkeypatch.setattr(fit_module, "_epoch", waiting)
+    runs = {}
+    for clock in ("wall", "cpu"):
+        c = FitConfig(epochs=3, patience=10, time_budget=0.2, budget_clock=clock)
+        runs[clock] = fit(clearancenet_learner(0), c)["log"]
+    assert len(runs["wall"]) == 1 and runs["wall"][0]["seconds"] >= 0.3
+    assert runs["cpu"][0]["seconds"] < runs["wall"][0]["seconds"]
+    assert len(runs["cpu"]) >= len(runs["wall"])
+
+
 @settings(max_examples=30, deadline=None)
 @given(n=st.integers(2, 500), seed=st.integers(0, 2**32 - 1))
 def test_validation_split_is_a_seeded_partition_with_a_tenth_held_out(n, seed):
@@ -137,6 +160,8 @@ def test_validation_split_is_a_seeded_partition_with_a_tenth_held_out(n, seed):
         ({"time_budget": float("inf")}, "time_budget"),
         ({"device": "tpu"}, "device"),
         ({"device": "cuda:7"}, "device"),
+        ({"budget_clock": "sundial"}, "budget_clock"),
+        ({"budget_clock": None}, "budget_clock"),
     ],
 )
 def test_bad_schedules_name_the_field(changes, field):

@@ -314,6 +314,7 @@ def _card(env: str, name: str, robot: str, c: TrainConfig, state: dict, data, te
             "epochs": len(log),
             "best_val_score": state["best"],
             "seconds": sum(e["seconds"] for e in log),
+            "clock": c.fit.budget_clock,
             "samples_per_s": float(np.mean([e["samples_per_s"] for e in log])) if log else None,
             "device": c.fit.device,
             "threads": torch.get_num_threads(),
