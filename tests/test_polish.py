@@ -6,13 +6,21 @@ from itertools import pairwise
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import gdnplan as gp
 from gdnplan.ccd import certify_path
 from gdnplan.distance import signed_distance
 from gdnplan.models import CoalModel
 from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
-from gdnplan.trajopt.polish import repair
+from gdnplan.trajopt.polish import (
+    POLISH_ITER_FACTOR,
+    POLISH_MIN_ITER,
+    polish,
+    polish_iterations,
+    repair,
+)
 from gdnplan.trajopt.result import _Run
 
 START, GOAL = [1.3, -2.9], [1.5, 0.1]  # planar2 around env a's square; the straight line hits it
@@ -74,3 +82,35 @@ def test_a_free_straight_line_is_returned_as_is(square, goal):
     assert result.success and result.iterations == 0, result.reason
     assert "repaired" not in result.reason and result.min_distance == np.inf
     assert result.seed is not None and result.seed.kind == "straight"  # no seed was refined
+
+
+@settings(max_examples=50, deadline=None)
+@given(iterations=st.integers(0, 10_000), attempts=st.integers(0, 20), max_iter=st.integers(1, 500))
+def test_the_polish_iteration_cap_follows_the_seeds_solves_within_its_bounds(
+    iterations, attempts, max_iter
+):
+    cap = polish_iterations(_Run(q=np.zeros((2, 2)), iterations=iterations, attempts=attempts),
+                            max_iter)  # fmt: skip
+    mean = -(-iterations // max(attempts, 1))
+    assert cap <= max_iter
+    assert cap == min(max_iter, max(POLISH_MIN_ITER, POLISH_ITER_FACTOR * mean))
+
+
+def test_every_polish_solve_gets_the_cap(square, monkeypatch):
+    """The polish's solves run with max_iter = the cap (not the seeds' max_iter), and a run
+    whose seeds took few iterations gets the floor."""
+    import gdnplan.trajopt.ipopt as ipopt_module
+
+    p, base = unpolished(square)
+    seen = []
+
+    def record(problem, model, goal, cfg, q0, run, deadline):
+        seen.append(cfg.optimizer.max_iter)
+        return q0, None, False
+
+    monkeypatch.setattr(ipopt_module, "_solve_refined", record)
+    cert = certify_path(square, base.q, p.certified_clearance)
+    run = _Run(q=base.q, iterations=40, attempts=2, verified=cert, seed=base.seed)
+    polish(p, CoalModel(), p.goal, PlanConfig(), run)
+    assert seen and all(m == polish_iterations(run, PlanConfig().optimizer.max_iter) for m in seen)
+    assert seen[0] == max(POLISH_MIN_ITER, POLISH_ITER_FACTOR * 20)

@@ -6,7 +6,12 @@ that path with other settings; the result is kept only when the certificate prov
   ``clearance_buffer`` above the certified clearance c. From the cheapest certified path the
   solves of :data:`POLISH_STAGES` in turn, each with a tighter stop, more check points per
   segment and a bound c + buffer closer to c, move the path towards the constrained optimum;
-  each replaces the path when it is certified and cheaper (path cost Σ‖Δq‖²).
+  each replaces the path when it is certified and cheaper (path cost Σ‖Δq‖²). A polish solve
+  starts from a converged, certified path, so it gets at most ``POLISH_ITER_FACTOR`` times the
+  seeds' mean iterations per solve (at least ``POLISH_MIN_ITER``, at most ``max_iter``): one
+  that needs more is stalling at its tighter stop, not improving the path (docs/decisions.md,
+  2026-12-03: a learned model's second stage ran to 150 iterations for a path no cheaper,
+  where coal's took 13).
 - repair: when no seed's path was certified (the refine rounds ran out with the path a little
   inside c between check points), one solve from the last path with ``REPAIR_EXTRA`` check
   points more per segment and the bound c + clearance_buffer + ``REPAIR_BUFFER``.
@@ -32,6 +37,8 @@ log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the st
 # the polish solves in turn: (check points' buffer above c (m), check points added per
 # segment, obj_change_tol)
 POLISH_STAGES = ((0.0005, 1, 1e-5), (0.0002, 2, 1e-6))
+POLISH_ITER_FACTOR = 2  # a polish solve's iteration cap: this × the seeds' mean per solve
+POLISH_MIN_ITER = 30  # … but never below this
 EXTRA_ROUNDS = 3  # refine rounds a polish or repair solve gets beyond RefineConfig.rounds
 REPAIR_EXTRA = 2  # check points per segment the repair adds
 REPAIR_BUFFER = 0.003  # m: extra bound of the repair's check points
@@ -58,6 +65,13 @@ def _again(
     return q, ok
 
 
+def polish_iterations(run: _Run, max_iter: int) -> int:
+    """Iteration cap of each polish solve: ``POLISH_ITER_FACTOR`` × the mean iterations of
+    ``run``'s solves so far (per seed attempt), within [``POLISH_MIN_ITER``, ``max_iter``]."""
+    mean = math.ceil(run.iterations / max(run.attempts, 1))
+    return min(max_iter, max(POLISH_MIN_ITER, POLISH_ITER_FACTOR * mean))
+
+
 def polish(
     problem: Problem,
     model: DistanceModel,
@@ -73,13 +87,16 @@ def polish(
         return
     opt, first = cfg.optimizer, path_cost(run.q)
     rounds = min(cfg.refine.rounds + EXTRA_ROUNDS, MAX_REFINE_ROUNDS)
+    cap = polish_iterations(run, opt.max_iter)
     for buffer, extra, stop in POLISH_STAGES:
         if run.verified is None or not run.verified.ok or time.perf_counter() >= deadline:
             return
         tight = replace(
             cfg,
             refine=replace(cfg.refine, clearance_buffer=buffer, rounds=rounds),
-            optimizer=replace(opt, interpolated=opt.interpolated + extra, obj_change_tol=stop),
+            optimizer=replace(
+                opt, interpolated=opt.interpolated + extra, obj_change_tol=stop, max_iter=cap
+            ),
         )
         t0, before, cert = time.perf_counter(), path_cost(run.q), run.verified
         q, ok = _again(problem, model, goal, tight, run, deadline)
