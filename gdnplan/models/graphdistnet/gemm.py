@@ -45,11 +45,11 @@ _N = 78  # ord("N"): no transpose
 
 def _torch_blas() -> ctypes.CDLL | None:
     """torch's CPU library when it exports the Fortran gemm routines, else None."""
-    path = Path(torch.__file__).parent / "lib" / "libtorch_cpu.so"
+    paths = sorted((Path(torch.__file__).parent / "lib").glob("*torch_cpu.*"))  # .so/.dylib/.dll
     try:
-        lib = ctypes.CDLL(str(path))
+        lib = ctypes.CDLL(str(paths[0]))
         lib.sgemm_, lib.dgemm_  # noqa: B018  (AttributeError when not exported)
-    except (OSError, AttributeError):
+    except (IndexError, OSError, AttributeError):
         return None
     return lib
 
