@@ -138,6 +138,13 @@ def utc_now() -> str:
     return f"{datetime.datetime.now(datetime.UTC):%Y-%m-%d %H:%M} UTC"
 
 
+def kernel_blas() -> str:
+    """The BLAS the fused kernels' products call (gdnplan.models.graphdistnet.gemm.BACKEND)."""
+    from gdnplan.models.graphdistnet import gemm
+
+    return gemm.BACKEND
+
+
 def header(threads: int) -> str:
     """The run's header as a markdown list (taken when the run starts)."""
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
@@ -150,6 +157,7 @@ def header(threads: int) -> str:
             f"- Python {platform.python_version()}, {versions()}",
             f"- git: {git_commit()}",
             f"- threads: {threads} (inference and torch)",
+            f"- products of the compiled kernels: {kernel_blas()}",
         ]
     )
 
