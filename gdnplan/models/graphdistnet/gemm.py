@@ -96,20 +96,27 @@ if numba is not None:
 
         return gemm
 
-    @numba.cfunc(_THREADS, cache=True)
-    def _no_threads(n):
-        return 0
+    def _no_threads():
+        @numba.cfunc(_THREADS, cache=True)
+        def none(n):
+            return 0
 
-    _s_fallback, _d_fallback = _fallback(np.float32), _fallback(np.float64)
+        return none
+
+    _KEPT: list = []  # the fallbacks in use: their code must live as long as the symbols
 
     def _register(lib: ctypes.CDLL | None) -> None:
-        """Point the kernels' symbols at ``lib``'s routines (None: the numpy fallbacks)."""
+        """Point the kernels' symbols at ``lib``'s routines (None: the numpy fallbacks, compiled
+        only then)."""
         threads = getattr(lib, "MKL_Set_Num_Threads_Local", None) if lib else None
-        binding.add_symbol("gdnplan_sgemm", _address(lib.sgemm_) if lib else _s_fallback.address)
-        binding.add_symbol("gdnplan_dgemm", _address(lib.dgemm_) if lib else _d_fallback.address)
-        binding.add_symbol(
-            "gdnplan_blas_threads", _address(threads) if threads else _no_threads.address
-        )
+        if lib is None:
+            _KEPT.extend((_fallback(np.float32), _fallback(np.float64)))
+        if threads is None:
+            _KEPT.append(_no_threads())
+        binding.add_symbol("gdnplan_sgemm", _address(lib.sgemm_) if lib else _KEPT[0].address)
+        binding.add_symbol("gdnplan_dgemm", _address(lib.dgemm_) if lib else _KEPT[1].address)
+        count = _address(threads) if threads else _KEPT[-1].address
+        binding.add_symbol("gdnplan_blas_threads", count)
 
     _sgemm = types.ExternalFunction("gdnplan_sgemm", _GEMM)
     _dgemm = types.ExternalFunction("gdnplan_dgemm", _GEMM)
