@@ -36,7 +36,7 @@ import numpy as np
 
 from .data import DATA_DIR, split_dir
 from .models.graphdistnet import GraphDistNetConfig
-from .train import FitConfig, GraphDistNetLoss, TrainConfig
+from .train import FitConfig, GraphDistNetLoss, TrainConfig, git_sha
 
 __all__ = [
     "BEST",
@@ -192,7 +192,7 @@ def score(weights: Path, env: str, s: Settings) -> dict:
     }  # fmt: skip
     if s.table2 and env in TABLE2_SETTINGS:
         out["t2_success"], out["t2_median"] = table2_ipopt(model, env, s.table2)
-        out["t2_n"] = s.table2
+        out["t2_n"], out["t2_git"] = s.table2, git_sha()  # the planner that solved them
     return out
 
 
@@ -293,7 +293,20 @@ def markdown(results: dict[str, list[list[dict]]], s: Settings) -> str:
                 f"({'/'.join(str(r['epochs']) for r in runs)}) |"
             )
     n_test = sorted({r["n_test"] for steps in results.values() for runs in steps for r in runs})
-    return "\n".join(lines) + "\n" + notes(s, "/".join(map(str, n_test)))
+    return "\n".join(lines) + "\n" + notes(s, "/".join(map(str, n_test))) + _planners(results)
+
+
+def _planners(results: dict[str, list[list[dict]]]) -> str:
+    """A note naming the planner versions of the Table II column when its rows were solved by
+    more than one (``t2_git``; rows scored before it was recorded: "before t2_git")."""
+    shas = {r.get("t2_git", "before t2_git")[:7] for steps in results.values() for runs in steps
+            for r in runs if "t2_success" in r}  # fmt: skip
+    if len(shas) < 2:
+        return ""
+    return (
+        f"Table II rows were solved by {len(shas)} planner versions ({', '.join(sorted(shas))}"
+        "): compare them within one version; delete the `.scores.json` files to re-score.\n"
+    )
 
 
 def notes(s: Settings, n_test: str) -> str:

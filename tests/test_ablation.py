@@ -107,3 +107,17 @@ def test_train_for_stops_starting_new_steps(tmp_path, monkeypatch):
                        log=lambda m: None, train_for=0.01)  # fmt: skip
     assert calls == ["faithful-s0"]  # started before the limit, the rest not
     assert [len(seeds) for seeds in out["b"]] == [1] + [0] * (len(ablation.STEPS) - 1)
+
+
+def test_the_table_says_when_table_ii_rows_come_from_different_planners():
+    """Rows solved by one planner version: no note; by two (or one before ``t2_git`` was
+    recorded): a note naming both."""
+    row = {"mae": 0.01, "auc": 0.99, "acd": 0.2, "n_test": 10, "seconds": 1.0, "epochs": 1,
+           "grad_time": 1e-4, "sweep_max": 0.01, "t2_success": 3, "t2_median": 2.0,
+           "t2_n": 4}  # fmt: skip
+    empty = [[] for _ in ablation.STEPS[2:]]
+    same = {"b": [[row | {"t2_git": "a" * 40}], [row | {"t2_git": "a" * 40}], *empty]}
+    assert "planner versions" not in ablation.markdown(same, ablation.Settings())
+    mixed = {"b": [[row], [row | {"t2_git": "b" * 40}], *empty]}
+    note = ablation.markdown(mixed, ablation.Settings())
+    assert "2 planner versions (bbbbbbb, before " in note
