@@ -4,8 +4,9 @@ Plans the reaching problems of ``gdnplan.table2.reaching_problems(setting)`` (``
 d, b or fetch; default d; RRT seed 0 for every problem) with Ipopt and one or more collision
 models (``--model GraphDistNet coal``: side by side, the models in turn on each problem, in
 alternating order), after one warm-up plan each, and reports per problem and model: certified
-or not, wall time (s), batched constraint evaluations (model passes), Ipopt iterations and
-path cost (rad²), then the medians and, for two models, the ratio of their median times.
+or not, wall time (s), the process's CPU time (s: the work, however busy the shared machine),
+batched constraint evaluations (model passes), Ipopt iterations and path cost (rad²), then the
+medians and, for two models, the ratios of their median wall and CPU times.
 Evaluation and iteration counts are deterministic for a given ``--threads`` (a different count
 changes the float32 sums and so Ipopt's path), so solver settings can be compared on a busy
 machine by counts; compare times only within one run.
@@ -32,6 +33,7 @@ are checked as a problem file's are (one line naming the setting on a bad one).
 from __future__ import annotations
 
 import json
+import time
 
 import common
 import numpy as np
@@ -108,6 +110,7 @@ def main() -> None:
         "constraints",
         "certified",
         "time (s)",
+        "CPU (s)",
         "evaluations",
         "iterations",
         "path cost (rad²)",
@@ -115,22 +118,26 @@ def main() -> None:
     rows: dict[str, list] = {m: [] for m in models}
     for i, problem in enumerate(problems):
         for m in models if i % 2 == 0 else models[::-1]:
+            cpu = time.process_time()
             r = gp.plan(problem, collision=factories[m](problem), solver=cfg)
-            rows[m].append((r.success, r.solve_time, r.model_calls, r.iterations, r.path_cost))
+            cpu = time.process_time() - cpu
+            rows[m].append((r.success, r.solve_time, cpu, r.model_calls, r.iterations, r.path_cost))
             table.add(
                 args.first + i,
                 m,
                 r.success,
                 f"{r.solve_time:.2f}",
+                f"{cpu:.2f}",
                 r.model_calls,
                 r.iterations,
                 f"{r.path_cost:.3f}",
             )
     stats = {m: [np.array(c) for c in zip(*rows[m], strict=True)] for m in models}
-    for m, (ok, t, calls, iters, cost) in stats.items():
+    for m, (ok, t, cpu, calls, iters, cost) in stats.items():
         report.text(
             f"**{m} ({args.setting}): {ok.sum()}/{len(ok)} certified, "
-            f"median time {np.median(t):.2f} s, median evaluations {np.median(calls):.1f}, "
+            f"median time {np.median(t):.2f} s (CPU {np.median(cpu):.2f} s), "
+            f"median evaluations {np.median(calls):.1f}, "
             f"median iterations {np.median(iters):.1f}, mean path cost {cost.mean():.3f} rad².**"
         )
     if len(models) > 1:
@@ -140,7 +147,9 @@ def main() -> None:
             f"**{a} / {b}: median time {np.median(sa[1]) / np.median(sb[1]):.2f}× "
             f"(certified {sa[0].sum()} vs {sb[0].sum()}); on the {both.sum()} problems both "
             f"certified {np.median(sa[1][both]) / np.median(sb[1][both]):.2f}×, median of the "
-            f"per-problem ratios {np.median(sa[1][both] / sb[1][both]):.2f}×.**"
+            f"per-problem ratios {np.median(sa[1][both] / sb[1][both]):.2f}×; median CPU time "
+            f"{np.median(sa[2]) / np.median(sb[2]):.2f}× (the process's CPU seconds: the work, "
+            "whatever else ran on the machine).**"
         )
     report.write()
 

@@ -162,3 +162,60 @@ def test_coal_rows_before_the_first_solve_where_the_model_underestimates(square,
     marked = underestimated_segments(square, Pessimist(), q, splits, margin, 0)
     assert marked.any()
     assert first.exact.tolist() == exact_check_points(splits, marked).tolist()
+
+
+def _trace_exact_rows(monkeypatch) -> list[tuple[str, np.ndarray | None]]:
+    """Events of a plan, in order: ("seed", None) when a seed is drawn, ("again", run.exact)
+    when a polish or repair solve starts, ("rows", segment mask) for every NLP built."""
+    from gdnplan.trajopt import ipopt as ipopt_module
+    from gdnplan.trajopt import polish as polish_module
+
+    events: list[tuple[str, np.ndarray | None]] = []
+    rows, draw, again = ipopt_module.with_exact_rows, ipopt_module.draw_seed, polish_module._again
+
+    def on_rows(model, splits, exact):
+        events.append(("rows", exact.copy()))
+        return rows(model, splits, exact)
+
+    def on_seed(*args, **kwargs):
+        events.append(("seed", None))
+        return draw(*args, **kwargs)
+
+    def on_again(problem, model, goal, cfg, run, deadline):
+        events.append(("again", None if run.exact is None else run.exact.copy()))
+        return again(problem, model, goal, cfg, run, deadline)
+
+    monkeypatch.setattr(ipopt_module, "with_exact_rows", on_rows)
+    monkeypatch.setattr(ipopt_module, "draw_seed", on_seed)
+    monkeypatch.setattr(polish_module, "_again", on_again)
+    return events
+
+
+def test_a_polish_starts_with_the_coal_rows_of_the_solve_that_made_its_path(square, monkeypatch):
+    """The liar's seed solves are rejected and end with coal rows on some segments; each seed
+    starts afresh (no coal rows: the liar underestimates nowhere), and each polish solve's
+    first NLP has coal rows on at least the segments of the solve that made its path."""
+    events = _trace_exact_rows(monkeypatch)
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=12)
+    cfg = PlanConfig(SeedConfig(initial="rrt", starts=2, count=2), RefineConfig(raise_window=1))
+    result = plan(p, collision=Liar(), solver=cfg)
+    assert result.success, result.reason
+    kinds = [kind for kind, _ in events]
+    starts = [i for i, kind in enumerate(kinds) if kind in ("seed", "again")]
+    assert kinds.count("seed") == 2 and "again" in kinds
+    for i in starts:
+        first = next(mask for kind, mask in events[i + 1 :] if kind == "rows")
+        if kinds[i] == "seed":
+            assert not first.any()
+        else:
+            carried = events[i][1]
+            assert carried is not None and carried.any()
+            assert np.all(first[carried])
+    ends = [*starts[1:], len(events)]  # each seed attempt's last NLP: its final coal rows
+    finals = [
+        [mask for kind, mask in events[i:end] if kind == "rows"][-1]
+        for i, end in zip(starts, ends, strict=True)
+        if kinds[i] == "seed"
+    ]
+    polish_first = next(i for i in starts if kinds[i] == "again")
+    assert any(np.array_equal(events[polish_first][1], m) for m in finals)

@@ -58,6 +58,7 @@ class _Best:
     status: str = ""
     info: SeedInfo | None = None
     cert: object = None
+    exact: np.ndarray | None = None
     certified: int = 0
 
 
@@ -107,6 +108,7 @@ def _plan_ipopt(
         if extra:
             label = f"{label}, {first + extra} check points per segment"
         attempt = replace(cfg, optimizer=replace(cfg.optimizer, interpolated=first + extra))
+        run.exact = None  # a new seed path: the last attempt's coal rows say nothing of it
         q, stats, ok = _solve_refined(problem, model, goal, attempt, guess, run, deadline)
         status = stats.get("return_status", "exception")
         if not ok:
@@ -120,9 +122,10 @@ def _plan_ipopt(
         if cost < best.cost:
             info = SeedInfo(kind, index, seed + index)
             best = replace(best, q=q, cost=cost, label=label, status=status, info=info)
-            best.cert = run.verified
+            best.cert, best.exact = run.verified, run.exact
     if best.q is not None:
         run.q, run.status, run.verified, run.seed = best.q, best.status, best.cert, best.info
+        run.exact = best.exact
         of = f" (least path cost of {best.certified} certified)" if best.certified > 1 else ""
         run.reason = f"{best.label}: {best.status}{of}"
     return run
@@ -146,7 +149,10 @@ def _solve_refined(
     segments and, for a learned model, gives the check points of the rejected segments and
     ``raise_window`` segments either side coal rows (``RefineConfig.exact_rows``,
     :mod:`gdnplan.trajopt.refine`), and before the first round so do the segments where the
-    model alone violates the bound at ``guess`` (:func:`~.refine.underestimated_segments`);
+    model alone violates the bound at ``guess`` (:func:`~.refine.underestimated_segments`)
+    and those that had coal rows in the solve that made ``guess`` (``run.exact``: a polish or
+    repair starts from a path whose own refine rounds found where the model errs; the final
+    mask is left in ``run.exact``);
     without exact rows it raises the constraint margin to the
     model's observed overestimate there (:func:`model_overestimate`) on the rejected segments and
     ``raise_window`` segments either side: the learned constraint then keeps the path away
@@ -166,10 +172,12 @@ def _solve_refined(
     margin = constraint_margin(problem, refine.clearance_buffer)  # above the certified clearance
     raised = np.zeros(len(splits))  # margin raise of each segment (m)
     exact = np.zeros(len(splits), bool)  # segments whose check points have coal rows
-    if exact_rows:  # coal rows where the model alone violates the bound (refine.py)
-        exact = underestimated_segments(
+    if exact_rows:  # coal rows where the model alone violates the bound (refine.py), and
+        exact = underestimated_segments(  # where the solve that made guess had them
             problem.scene, model, guess, splits, margin, refine.raise_window
         )
+        if run.exact is not None and len(run.exact) == len(exact):
+            exact |= run.exact
     q, duals, stats = guess, None, {"return_status": "time budget ended"}
     for round_ in range(1 + (refine.rounds if refine.ccd else 0)):
         t0 = time.perf_counter()
@@ -188,6 +196,7 @@ def _solve_refined(
         status = stats["return_status"]
         took, its = time.perf_counter() - t0, stats.get("iter_count", 0)
         log.info("solve: Ipopt round %d: %s, %d iterations, %.2f s", round_ + 1, status, its, took)
+        run.exact = exact.copy() if exact_rows else None
         if status in SOLVER_ERRORS or status.startswith("exception"):
             run.verified = None  # q is not a solver iterate: never accept it
             return q, stats, False

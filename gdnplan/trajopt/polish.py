@@ -56,12 +56,12 @@ def _again(
     certificate unless the new path is certified (iterations and model calls add up)."""
     from .ipopt import _solve_refined  # ipopt imports nothing of this module's users
 
-    trial = _Run(q=run.q)
+    trial = _Run(q=run.q, exact=run.exact)
     q, _, ok = _solve_refined(problem, model, goal, cfg, run.q, trial, deadline)
     run.iterations += trial.iterations
     run.model_calls += trial.model_calls
     if ok:
-        run.verified = trial.verified
+        run.verified, run.exact = trial.verified, trial.exact
     return q, ok
 
 

@@ -108,6 +108,7 @@ class _Run:
     attempts: int = 0
     verified: Certificate | None = None  # q's certificate at the certified clearance, if made
     seed: SeedInfo | None = None  # the seed q was refined from, when certified
+    exact: np.ndarray | None = None  # (T − 1,) segments whose check points q's solve gave coal rows
 
 
 def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
