@@ -212,9 +212,12 @@ def seed_path(
     seed: int = 0,
     time_limit: float = 10.0,
     step: float = 2.0,
+    max_iterations: int = 5000,
 ) -> tuple[np.ndarray | None, RRTResult]:
-    """RRT-Connect + shortcut + resample: (n_waypoints, dof) seed, or None on failure."""
-    res = rrt_connect(scene, start, goal, clearance, step=step, seed=seed, time_limit=time_limit)
+    """RRT-Connect (at most ``max_iterations`` extensions) + shortcut + resample:
+    (n_waypoints, dof) seed, or None on failure."""
+    res = rrt_connect(scene, start, goal, clearance, step=step, seed=seed, time_limit=time_limit,
+                      max_iterations=max_iterations)  # fmt: skip
     if not res.success:
         return None, res
     path = shortcut(scene, res.path, clearance, seed=seed)

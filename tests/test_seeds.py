@@ -279,7 +279,6 @@ def test_an_rrt_seed_is_the_cheapest_of_its_draws(monkeypatch):
 
     problem = Problem.from_toml("planar2_square")
     request = SeedRequest(problem, problem.goal, problem.margin, 2, 0, 30.0, 2.0)
-    monkeypatch.setattr(seeds, "SCREEN_TIME", 60.0)
     monkeypatch.setattr(seeds, "SCREENED", 1)
     first = seeds.rrt_seed(request)
     monkeypatch.setattr(seeds, "SCREENED", 4)
@@ -290,3 +289,40 @@ def test_an_rrt_seed_is_the_cheapest_of_its_draws(monkeypatch):
     np.testing.assert_array_equal(draws[0], first)
     assert np.sum(np.diff(best, axis=0) ** 2) == pytest.approx(min(costs))
     assert certify_path(problem.scene, best, problem.margin).ok
+
+
+class _SlowClock:
+    """A clock that advances ``tick`` s every time it is read: a machine slower or busier than
+    any real one."""
+
+    def __init__(self, tick: float) -> None:
+        self.now, self.tick = 0.0, tick
+
+    def perf_counter(self) -> float:
+        self.now += self.tick
+        return self.now
+
+
+@pytest.mark.parametrize("name", ["planar2_square", "planar7_d"])
+def test_an_rrt_seed_does_not_depend_on_the_clock(name, monkeypatch):
+    """Every screening draw runs however slow the clock (within the seed's time limit), and
+    the seed equals the one of a normal clock: the same problem and stream give the same seed
+    at any load."""
+    from gdnplan.trajopt import seeds
+
+    problem = Problem.from_toml(name)
+    request = SeedRequest(problem, problem.goal, problem.margin, 2, 0, 30.0, 0.5)
+    normal = seeds.rrt_seed(request)
+    draws = []
+    real = seeds.seed_path
+
+    def counted(*args, **kwargs):
+        draws.append(kwargs["seed"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(seeds, "seed_path", counted)
+    monkeypatch.setattr(seeds, "time", _SlowClock(0.9))
+    slow = seeds.rrt_seed(request)
+    assert len(draws) == seeds.SCREENED
+    assert normal is not None and slow is not None
+    np.testing.assert_array_equal(slow, normal)

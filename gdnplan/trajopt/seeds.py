@@ -33,7 +33,8 @@ log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the st
 
 VIA_DRAWS = 100  # random via points drawn until one clears the demanded clearance
 SCREENED = 4  # RRT-Connect paths drawn per rrt seed; the cheapest is refined (decisions.md)
-SCREEN_TIME = 1.0  # s: the draws after the first share this
+SCREEN_ITER_FACTOR = 4  # a later draw's RRT-Connect extensions: at most this × the first's …
+SCREEN_MIN_ITER = 200  # … and at least this (a bound by work, not by the clock)
 SCREEN_STRIDE = 100_003  # stream offset of draw j (far from the streams of other seeds)
 OMPL_TIME = 1.0  # s: planning + simplification of one OMPL seed (docs/decisions.md)
 HAS_OMPL = find_spec("ompl") is not None
@@ -87,17 +88,19 @@ def rrt_seed(request: SeedRequest) -> np.ndarray | None:
     (:func:`gdnplan.rrt.seed_path`; path j on stream ``request.stream + SCREEN_STRIDE · j``,
     path 0 on ``request.stream`` itself) by path cost Σ‖Δq‖²: RRT-Connect's paths fall into
     different homotopy classes, and refining the cheapest draw is far cheaper than refining
-    each. Paths after the first share ``SCREEN_TIME`` s (and ``request.time_limit``)."""
+    each. A draw after the first may take at most ``SCREEN_ITER_FACTOR`` × the first's
+    RRT-Connect extensions (at least ``SCREEN_MIN_ITER``): bounded by work, not by the clock,
+    so the seed of a problem and stream is the same on any machine and at any load;
+    ``request.time_limit`` bounds the whole (only a machine too slow to finish within it
+    sees fewer draws)."""
     p = request.problem
     t0, best, best_cost = time.perf_counter(), None, math.inf
-    first = t0  # when the first draw ended
+    cap = 5000  # rrt_connect's own cap for the first draw
     for j in range(SCREENED):
         left = request.time_limit - (time.perf_counter() - t0)
-        if j:
-            left = min(left, SCREEN_TIME - (time.perf_counter() - first))
         if left <= 0:
             break
-        path, _ = seed_path(
+        path, res = seed_path(
             p.scene,
             p.start,
             request.goal,
@@ -106,9 +109,10 @@ def rrt_seed(request: SeedRequest) -> np.ndarray | None:
             seed=request.stream + SCREEN_STRIDE * j,
             time_limit=left,
             step=request.rrt_step,
+            max_iterations=cap,
         )
         if j == 0:
-            first = time.perf_counter()
+            cap = min(cap, max(SCREEN_MIN_ITER, SCREEN_ITER_FACTOR * res.iterations))
         if path is not None and (cost := float(np.sum(np.diff(path, axis=0) ** 2))) < best_cost:
             best, best_cost = path, cost
     return best
