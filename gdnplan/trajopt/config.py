@@ -147,7 +147,8 @@ class RefineConfig:
             that get coal rows.
         exact_rows: (Ipopt, learned models) a refine round constrains the check points of
             those segments by coal's exact distance instead of the model's raised bound
-            (:mod:`gdnplan.trajopt.refine`).
+            (:mod:`gdnplan.trajopt.refine`); a polish or repair solve starts with coal rows
+            where the solve that made its path had them.
         polish: (Ipopt) more solves from the cheapest certified path with tighter stops,
             more check points and smaller buffers; each kept when certified and cheaper
             (:func:`gdnplan.trajopt.polish.polish`).
