@@ -116,8 +116,11 @@ def test_the_table_says_when_table_ii_rows_come_from_different_planners():
            "grad_time": 1e-4, "sweep_max": 0.01, "t2_success": 3, "t2_median": 2.0,
            "t2_n": 4}  # fmt: skip
     empty = [[] for _ in ablation.STEPS[2:]]
-    same = {"b": [[row | {"t2_git": "a" * 40}], [row | {"t2_git": "a" * 40}], *empty]}
-    assert "planner versions" not in ablation.markdown(same, ablation.Settings())
+    one = row | {"t2_git": "a" * 40}
+    same = {"b": [[one | {"t2_cpu": 1.5}], [one], *empty]}
+    text = ablation.markdown(same, ablation.Settings())
+    assert "planner versions" not in text
+    assert "| 3/4 | 2.00 | 1.50 |" in text and "| 3/4 | 2.00 | – |" in text  # CPU s when recorded
     mixed = {"b": [[row], [row | {"t2_git": "b" * 40}], *empty]}
     note = ablation.markdown(mixed, ablation.Settings())
     assert "2 planner versions (bbbbbbb, before " in note
