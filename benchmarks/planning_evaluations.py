@@ -1,18 +1,20 @@
 """Where a Table II solve's work goes: constraint evaluations, Ipopt iterations, time, cost.
 
-Plans the reaching problems of ``gdnplan.table2.reaching_problems(setting)`` (``--setting``
-d, b or fetch; default d; RRT seed 0 for every problem) with Ipopt and one or more collision
-models (``--model GraphDistNet coal``: side by side, the models in turn on each problem, in
-alternating order), after one warm-up plan each, and reports per problem and model: certified
-or not, wall time (s), the process's CPU time (s: the work, however busy the shared machine),
-batched constraint evaluations (model passes), Ipopt iterations and path cost (rad²), then the
-medians and, for two models, the ratios of their median wall and CPU times.
-Evaluation and iteration counts are deterministic for a given ``--threads`` (a different count
-changes the float32 sums and so Ipopt's path), so solver settings can be compared on a busy
-machine by counts; compare times only within one run.
+Plans the reaching problems of ``gdnplan.table2.reaching_problems(setting)`` (``--setting`` d, b
+or fetch; default d; RRT seed 0 for every problem) with Ipopt and one or more collision models
+(``--model GraphDistNet coal``: side by side, the models in turn on each problem, in alternating
+order; a ``.safetensors`` path stands for GraphDistNet with those weights), after one warm-up
+plan each, and reports per problem and model: certified or not, wall time (s), the process's CPU
+time (s: the work, however busy the shared machine), batched constraint evaluations (model
+passes), Ipopt iterations and path cost (rad²), then the medians and, for two models, the ratios
+of their median wall and CPU times. Evaluation and iteration counts are deterministic for a
+given ``--threads`` (a different count changes the float32 sums and so Ipopt's path), so solver
+settings can be compared on a busy machine by counts; compare times only within one run.
 
     python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet
     python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet coal --setting fetch
+    python benchmarks/planning_evaluations.py --threads 1 --setting fetch \
+        --model runs/ur5e-one-way.safetensors coal   # other weights
     python benchmarks/planning_evaluations.py --threads 1 --model GraphDistNet coal \
         --setting fetch --first 10 --n 10   # problems 10-19 (halves run in parallel)
     python benchmarks/planning_evaluations.py --threads 1 --model coal \
@@ -57,6 +59,14 @@ def _pairs(items: list[str]) -> dict:
     return out
 
 
+def factory(model: str, setting: str):
+    """problem → collision model: a method of Table II, or GraphDistNet weights by path."""
+    if not model.endswith(".safetensors"):
+        return model_factory(model, setting)
+    loaded = gp.load_model(model)
+    return lambda problem: loaded
+
+
 def plan_config(settings: list[str], ipopt_options: list[str]) -> PlanConfig:
     """The PlanConfig of ``--set table.key=value`` (or an old bare field name) and ``--ipopt
     name=value`` items, checked like a problem file's tables (exits with one line if not)."""
@@ -82,8 +92,8 @@ def main() -> None:
         "--model",
         nargs="+",
         default=["GraphDistNet"],
-        choices=["GraphDistNet", "coal"],
-        help="collision model(s); several run side by side, problem by problem",
+        help="collision model(s): GraphDistNet, coal or a GraphDistNet .safetensors path; "
+        "several run side by side, problem by problem",
     )
     p.add_argument("--setting", default="d", choices=list(SETTINGS))
     p.add_argument("--n", type=int, default=20)
@@ -93,7 +103,10 @@ def main() -> None:
     args = common.parse(p)
     cfg = plan_config(args.set, args.ipopt)
     models = list(dict.fromkeys(args.model))
-    factories = {m: model_factory(m, args.setting) for m in models}
+    for m in models:
+        if m not in ("GraphDistNet", "coal") and not m.endswith(".safetensors"):
+            p.error(f"--model: {m!r} is neither GraphDistNet, coal nor a .safetensors path")
+    factories = {m: factory(m, args.setting) for m in models}
     problems = reaching_problems(args.setting)[args.first : args.first + args.n]
     report = common.Report(
         args, "Planning: evaluations per Table II solve", common.first_paragraph(__doc__)
