@@ -3,7 +3,7 @@
 Plans the reaching problems of ``gdnplan.table2.reaching_problems(setting)`` (``--setting`` d, b
 or fetch; default d; RRT seed 0 for every problem) with Ipopt and one or more collision models
 (``--model GraphDistNet coal``: side by side, the models in turn on each problem, in alternating
-order; a ``.safetensors`` path stands for GraphDistNet with those weights), after one warm-up
+order; any other name is GraphDistNet weights by path or shipped name), after one warm-up
 plan each, and reports per problem and model: certified or not, wall time (s), the process's CPU
 time (s: the work, however busy the shared machine), batched constraint evaluations (model
 passes), Ipopt iterations and path cost (rad²), then the medians and, for two models, the ratios
@@ -41,6 +41,7 @@ import common
 import numpy as np
 
 import gdnplan as gp
+from gdnplan.errors import GdnplanError
 from gdnplan.table2 import SETTINGS, model_factory, reaching_problems
 from gdnplan.trajopt import OLD_KEYS, PlanConfig
 from gdnplan.trajopt.problem_file import plan_config_from_tables
@@ -60,8 +61,9 @@ def _pairs(items: list[str]) -> dict:
 
 
 def factory(model: str, setting: str):
-    """problem → collision model: a method of Table II, or GraphDistNet weights by path."""
-    if not model.endswith(".safetensors"):
+    """problem → collision model: GraphDistNet (the setting's shipped weights) or coal, else
+    GraphDistNet weights by path or shipped name (``gp.load_model``'s error names a bad one)."""
+    if model in ("GraphDistNet", "coal"):
         return model_factory(model, setting)
     loaded = gp.load_model(model)
     return lambda problem: loaded
@@ -92,8 +94,8 @@ def main() -> None:
         "--model",
         nargs="+",
         default=["GraphDistNet"],
-        help="collision model(s): GraphDistNet, coal or a GraphDistNet .safetensors path; "
-        "several run side by side, problem by problem",
+        help="collision model(s): GraphDistNet, coal, or GraphDistNet weights by path or "
+        "shipped name; several run side by side, problem by problem",
     )
     p.add_argument("--setting", default="d", choices=list(SETTINGS))
     p.add_argument("--n", type=int, default=20)
@@ -103,10 +105,10 @@ def main() -> None:
     args = common.parse(p)
     cfg = plan_config(args.set, args.ipopt)
     models = list(dict.fromkeys(args.model))
-    for m in models:
-        if m not in ("GraphDistNet", "coal") and not m.endswith(".safetensors"):
-            p.error(f"--model: {m!r} is neither GraphDistNet, coal nor a .safetensors path")
-    factories = {m: factory(m, args.setting) for m in models}
+    try:
+        factories = {m: factory(m, args.setting) for m in models}
+    except GdnplanError as e:
+        p.error(f"--model: {e}")
     problems = reaching_problems(args.setting)[args.first : args.first + args.n]
     report = common.Report(
         args, "Planning: evaluations per Table II solve", common.first_paragraph(__doc__)
