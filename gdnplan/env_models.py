@@ -12,18 +12,33 @@ import numpy as np
 
 from .assets import WEIGHTS_DIR
 from .data import Dataset
+from .errors import InputError
 from .models import DistanceModel
 
 
 class BatchedGraphDistNet:
     """GraphDistNet with :meth:`predict_dataset`: one batched pass over samples with their own
-    obstacle graphs (graph construction included), via :mod:`gdnplan.train`'s tensors."""
+    obstacle graphs (graph construction included), via :mod:`gdnplan.train`'s tensors.
+
+    ``draws`` R > 1 (the paper's network only, ``cross="argmax"``, whose first layer picks a
+    random partner per graph): :meth:`predict_dataset` returns the mean over R draws of that
+    pick (generator seeds 0 … R − 1), d̄ = (1/R) Σ_r d̂_r and ∂d̄/∂q = (1/R) Σ_r ∂d̂_r/∂q, an
+    estimate of d̂'s expectation over the draw; R = 1 is the one draw of seed 0.
+    """
 
     name = "GraphDistNet"
     is_distance = True
 
-    def __init__(self, model):
+    def __init__(self, model, draws: int = 1):
+        if isinstance(draws, bool) or not isinstance(draws, int) or draws < 1:
+            raise InputError(f"draws: expected a positive integer, got {draws!r}")
+        if draws > 1 and model.config.cross != "argmax":
+            raise InputError(
+                "draws: only the paper's network (cross='argmax') draws a random partner; "
+                f"this one has cross={model.config.cross!r}"
+            )
         self.model = model
+        self.draws = draws
 
     def distance(self, scene, q: np.ndarray) -> np.ndarray:
         return self.model.distance(scene, q)
@@ -35,7 +50,10 @@ class BatchedGraphDistNet:
         from .train import predict as predict_net
         from .train import tensors
 
-        return predict_net(self.model.net, tensors(ds), grad=grad)
+        t = tensors(ds)
+        runs = [predict_net(self.model.net, t, grad=grad, seed=r) for r in range(self.draws)]
+        d = np.mean([r[0] for r in runs], axis=0)
+        return d, (np.mean([r[1] for r in runs], axis=0) if grad else None)
 
 
 def graphdistnet_of_env(env: str, weights_dir: Path = WEIGHTS_DIR) -> DistanceModel | None:

@@ -95,6 +95,7 @@ def test_reproduce_table1_fast_writes_markdown(tmp_path):
     faithful = "| a | GraphDistNet (paper architecture, this implementation) | "
     trained = (ev.WEIGHTS_DIR / "a_faithful.safetensors").exists()
     assert (faithful + "not trained yet |" in text) != trained and faithful in text
+    assert "| a | GraphDistNet (paper architecture, mean of 8 first-layer draws) | " in text
     assert "- (a) GraphDistNet (gdnplan): soft nearest-node partners" in text  # its network
 
 
@@ -146,3 +147,26 @@ def test_one_name_per_loader_and_the_old_names_warn():
         assert ev.load_clearancenet("a") is not None
     with pytest.warns(DeprecationWarning, match="load_graphdistnet_weights"):
         load_graphdistnet(weights_file("a"))
+
+
+def test_mean_of_draws_is_the_mean_of_single_draws():
+    """The mean-of-draws row: d̂ and ∂d̂/∂q averaged over generator seeds 0 … R − 1; one draw is
+    seed 0's; the draws differ (the first layer is random); soft-partner networks refuse."""
+    from gdnplan.env_models import BatchedGraphDistNet
+    from gdnplan.train import predict, tensors
+
+    model = gp.load_model(ev.WEIGHTS_DIR / "b_faithful.safetensors")
+    ds = make_shard("b", 1, 0, 40)
+    t = tensors(ds)
+    runs = [predict(model.net, t, grad=True, seed=r) for r in range(3)]
+    d3, g3 = BatchedGraphDistNet(model, draws=3).predict_dataset(ds, grad=True)
+    np.testing.assert_allclose(d3, np.mean([r[0] for r in runs], 0), rtol=1e-12)
+    np.testing.assert_allclose(g3, np.mean([r[1] for r in runs], 0), rtol=1e-12)
+    d1, g1 = BatchedGraphDistNet(model).predict_dataset(ds, grad=False)
+    np.testing.assert_array_equal(d1, runs[0][0])
+    assert g1 is None and np.abs(runs[1][0] - runs[0][0]).max() > 1e-4
+    for bad in (0, -1, 2.0, True):
+        with pytest.raises(gp.InputError, match="draws"):
+            BatchedGraphDistNet(model, draws=bad)
+    with pytest.raises(gp.InputError, match="argmax"):
+        BatchedGraphDistNet(gp.load_model("b"), draws=2)

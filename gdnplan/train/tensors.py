@@ -93,11 +93,18 @@ def forward_with_grad(
 
 
 def predict(
-    net: GraphDistNet, t: Tensors, chunk: int = 256, device: str = "cpu", grad: bool = True
+    net: GraphDistNet,
+    t: Tensors,
+    chunk: int = 256,
+    device: str = "cpu",
+    grad: bool = True,
+    seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray | None]:
-    """d̂ (n,) and, with ``grad``, ∂d̂/∂q (n, dof) for every sample of ``t`` (float64)."""
+    """d̂ (n,) and, with ``grad``, ∂d̂/∂q (n, dof) for every sample of ``t`` (float64);
+    ``seed`` seeds the generator of the paper network's random first-layer partners (one
+    stream over the chunks of ``chunk`` samples)."""
     net.eval()
-    gen = torch.Generator(device=device).manual_seed(0)
+    gen = torch.Generator(device=device).manual_seed(seed)
     ds, gs = [], []
     for s in range(0, len(t), chunk):
         rows = torch.arange(s, min(s + chunk, len(t)))
