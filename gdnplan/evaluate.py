@@ -308,7 +308,9 @@ Notes (how each number is made; `paper` columns are the paper's Table I):
   0–7 (8× the time). The paper does not say how its test-time d̂ treats that draw ("Although
   we randomly select each $j_c$ for initial graph construction, $j_c$ is not necessarily a
   random index after the first message passing", §IV-A). Every GraphDistNet row stands beside
-  the paper's GraphDistNet numbers.
+  the paper's GraphDistNet numbers; where the paper-architecture rows fall short of them, and
+  why: `benchmarks/results/faithful_shortfall.md` (`benchmarks/faithful_shortfall.py`) and
+  docs/decisions.md.
 - ClearanceNet: MLP 3×256 ReLU on [q/π, obstacle poses (centre, cos 4θ, sin 4θ) or padded
   α-shape vertices], dropout 0.5 for d and e, Adam on data/<env>/train (weights card: data,
   epochs, seconds); a 120 s training budget per environment on this CPU.
