@@ -306,8 +306,8 @@ def markdown(results: dict[str, list[list[dict]]], s: Settings) -> str:
 def _planners(results: dict[str, list[list[dict]]]) -> str:
     """A note naming the planner versions of the Table II column when its rows were solved by
     more than one (``t2_git``; rows scored before it was recorded: "before t2_git")."""
-    shas = {r.get("t2_git", "before t2_git")[:7] for steps in results.values() for runs in steps
-            for r in runs if "t2_success" in r}  # fmt: skip
+    shas = {r["t2_git"][:7] if "t2_git" in r else "before t2_git" for steps in results.values()
+            for runs in steps for r in runs if "t2_success" in r}  # fmt: skip
     if len(shas) < 2:
         return ""
     return (

@@ -123,4 +123,4 @@ def test_the_table_says_when_table_ii_rows_come_from_different_planners():
     assert "| 3/4 | 2.00 | 1.50 |" in text and "| 3/4 | 2.00 | – |" in text  # CPU s when recorded
     mixed = {"b": [[row], [row | {"t2_git": "b" * 40}], *empty]}
     note = ablation.markdown(mixed, ablation.Settings())
-    assert "2 planner versions (bbbbbbb, before " in note
+    assert "2 planner versions (bbbbbbb, before t2_git)" in note
