@@ -24,6 +24,23 @@ def test_each_step_changes_one_field_of_the_step_before():
         assert changed == list(ablation.STEPS[step][2]), ablation.STEPS[step][0]
 
 
+def test_every_ablated_option_is_what_some_shipped_network_uses():
+    """Issue #25's rule for options: one whose step buys nothing is removed unless a shipped
+    network needs it. Every step's changed value is set by at least one shipped card (the
+    paper's argmax by the ``*_faithful`` ones), so each option stays; retraining the last
+    user without it makes this fail and the option a candidate for removal."""
+    from gdnplan.assets import WEIGHTS_DIR
+
+    cards = [json.loads(p.read_text()) for p in WEIGHTS_DIR.glob("*.json")]
+    configs = [
+        GraphDistNetConfig.from_dict(c["config"]) for c in cards if c.get("model") == "graphdistnet"
+    ]
+    assert any(c.cross == "argmax" for c in configs)  # the faithful step's network
+    for name, _, change in ablation.STEPS[1:]:
+        users = [c for c in configs if all(getattr(c, k) == v for k, v in change.items())]
+        assert users, f"step {name}: no shipped network uses {change}"
+
+
 def test_faithful_run_has_the_shipped_weights_data_and_budget():
     c = ablation.faithful_config("a", "data")
     assert c.network == GraphDistNetConfig.faithful() and c.loss == training.GraphDistNetLoss()
