@@ -230,3 +230,38 @@ def scatter_figure(points: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]) 
         ax.legend(fontsize=7, markerscale=4)
     fig.tight_layout()
     return fig
+
+
+ABLATION_PANELS = (  # (score key, unit factor, axis label, log scale, over seeds)
+    ("mae", 1e3, "MAE (mm)", True, "mean"),
+    ("acd", 1.0, "ACD", False, "mean"),
+    ("grad_time", 1e3, "d̂ + ∇ (ms / configuration)", True, "mean"),
+    ("sweep_max", 1e2, "largest sweep step (cm)", True, "max"),
+)
+
+
+def ablation_figure(steps: list[str], results: dict[str, list[list[dict]]]) -> Figure:
+    """The ablation's columns over its steps, one line per environment: MAE, ACD, d̂ + ∇ time
+    and the largest d̂ step of the joint sweeps (``results[env][step]`` = the scores of each
+    trained seed, :func:`gdnplan.ablation.run`). MAE, ACD and time: the mean over seeds ± its
+    standard error (≥ 2 seeds); sweeps: the largest over seeds; untrained steps are gaps."""
+    if any(len(per_step) != len(steps) for per_step in results.values()):
+        raise InputError("results: expected one list of seed scores per step for every env")
+    fig = Figure(figsize=(4.2 * len(ABLATION_PANELS), 4.2))
+    x = np.arange(len(steps))
+    for k, (key, unit, label, log, over) in enumerate(ABLATION_PANELS, start=1):
+        ax = fig.add_subplot(1, len(ABLATION_PANELS), k)
+        for env, per_step in results.items():
+            values = [unit * np.array([r[key] for r in runs]) for runs in per_step]
+            mid = [np.nan if not v.size else v.max() if over == "max" else v.mean() for v in values]
+            se = [v.std(ddof=1) / np.sqrt(v.size) if v.size > 1 and over == "mean" else 0.0
+                  for v in values]  # fmt: skip
+            ax.errorbar(x, mid, yerr=se, marker="o", capsize=3, label=f"({env})")
+        ax.set_xticks(x, steps, rotation=40, ha="right")
+        ax.set_ylabel(label)
+        if log:
+            ax.set_yscale("log")
+        ax.grid(alpha=0.3)
+    fig.axes[0].legend()
+    fig.tight_layout()
+    return fig

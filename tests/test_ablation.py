@@ -70,10 +70,15 @@ def test_trained_steps_are_kept_and_skipped(tmp_path, monkeypatch):
 
 def test_fast_cli_writes_the_table_and_refuses_bad_input(tmp_path):
     out = tmp_path / "ablation.md"
-    args = ["reproduce", "ablation", "--fast", "--envs", "b", "--seeds", "1", "--out", str(out)]
+    fig = tmp_path / "ablation.png"
+    args = ["reproduce", "ablation", "--fast", "--envs", "b", "--seeds", "1", "--out", str(out),
+            "--figure", str(fig)]  # fmt: skip
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     assert "fast mode" in out.read_text() and out.read_text().count("\n| b |") == 7
+    assert fig.read_bytes()[:4] == b"\x89PNG"
+    wrong = CliRunner().invoke(app, [*args[:-1], str(tmp_path / "a.txt")])
+    assert wrong.exit_code != 0 and "--figure" in str(wrong.exception)
     bad = CliRunner().invoke(app, ["reproduce", "ablation", "--fast", "--envs", "z"])
     assert bad.exit_code != 0 and "--envs" in str(bad.exception)
 
@@ -141,3 +146,23 @@ def test_the_table_says_when_table_ii_rows_come_from_different_planners():
     mixed = {"b": [[row], [row | {"t2_git": "b" * 40}], *empty]}
     note = ablation.markdown(mixed, ablation.Settings())
     assert "2 planner versions (bbbbbbb, before t2_git)" in note
+
+
+def test_ablation_figure_plots_means_gaps_and_refuses_a_wrong_shape():
+    """Two seeds: the MAE point is their mean (mm) with the standard error as its bar; an
+    untrained step is a gap (NaN); a results dict with another step count is refused."""
+    import numpy as np
+
+    from gdnplan.errors import InputError
+    from gdnplan.viz import ablation_figure
+
+    def scores(mae):
+        return {"mae": mae, "acd": 0.2, "grad_time": 1e-4, "sweep_max": 0.01}
+
+    results = {"b": [[scores(0.010), scores(0.012)], []]}
+    fig = ablation_figure(["faithful", "soft-partners"], results)
+    line = fig.axes[0].lines[0]
+    np.testing.assert_allclose(line.get_ydata()[0], 11.0)
+    assert np.isnan(line.get_ydata()[1]) and len(fig.axes) == 4
+    with pytest.raises(InputError, match="one list of seed scores per step"):
+        ablation_figure(["faithful"], results)

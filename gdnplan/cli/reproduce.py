@@ -203,6 +203,9 @@ def ablation_command(
         None, help="Start no training after this many seconds (0: table of the kept steps)."
     ),
     out: Path = typer.Option(Path("results/ablation.md"), help="Markdown output."),
+    figure: Path = typer.Option(
+        None, help="Also plot the columns over the steps (.png, .pdf, .svg)."
+    ),
 ) -> None:
     """Faithful → soft partners → one-way → node distances → soft-minimum readout → probe
     points → band readout, one change a step, same data, budget and seeds (resumable)."""
@@ -213,6 +216,8 @@ def ablation_command(
     from ..data import DATA_DIR, generate, split_dir
 
     check_output_path(out, (".md",), "--out")
+    if figure is not None:
+        check_output_path(figure, FIGURE_SUFFIXES, "--figure")
     chosen = tuple(e.strip() for e in envs.split(",") if e.strip())
     if not chosen or any(e not in ablation.BEST for e in chosen):
         raise InputError(f"--envs: expected some of {sorted(ablation.BEST)}, got {envs!r}")
@@ -250,6 +255,11 @@ def ablation_command(
     ])  # fmt: skip
     typer.echo(text)
     write_text(out, text, "--out")
+    if figure is not None:
+        from ..viz import ablation_figure, save_figure
+
+        save_figure(ablation_figure([name for name, _, _ in ablation.STEPS], results), figure)
+        typer.echo(f"wrote {figure}", err=True)
 
 
 @reproduce_app.command("faithful")
