@@ -23,7 +23,8 @@ class BatchedGraphDistNet:
     ``draws`` R > 1 (the paper's network only, ``cross="argmax"``, whose first layer picks a
     random partner per graph): :meth:`predict_dataset` returns the mean over R draws of that
     pick (generator seeds 0 … R − 1), d̄ = (1/R) Σ_r d̂_r and ∂d̄/∂q = (1/R) Σ_r ∂d̂_r/∂q, an
-    estimate of d̂'s expectation over the draw; R = 1 is the one draw of seed 0.
+    estimate of d̂'s expectation over the draw; R = 1 is the one draw of seed 0. The per-scene
+    :meth:`distance` and :meth:`distance_and_grad` stay one draw.
     """
 
     name = "GraphDistNet"
