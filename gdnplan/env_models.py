@@ -13,6 +13,7 @@ import numpy as np
 from .assets import WEIGHTS_DIR
 from .data import Dataset
 from .errors import InputError
+from .limits import MAX_DRAWS, check_int
 from .models import DistanceModel
 
 
@@ -31,8 +32,7 @@ class BatchedGraphDistNet:
     is_distance = True
 
     def __init__(self, model, draws: int = 1):
-        if isinstance(draws, bool) or not isinstance(draws, int) or draws < 1:
-            raise InputError(f"draws: expected a positive integer, got {draws!r}")
+        draws = check_int(draws, "draws", 1, MAX_DRAWS)
         if draws > 1 and model.config.cross != "argmax":
             raise InputError(
                 "draws: only the paper's network (cross='argmax') draws a random partner; "

@@ -22,6 +22,7 @@ MAX_TIME_BUDGET = 3600.0  # s, SeedConfig.time_budget of one plan call
 MAX_ITER = 10_000  # Ipopt iterations per attempt
 MAX_ADAM_ITERATIONS = 100_000
 MAX_RRT_TIME = 600.0  # s, one RRT-Connect run
+MAX_DRAWS = 1000  # BatchedGraphDistNet draws: each is a whole pass over the samples
 MAX_TIMED_SAMPLES = 1_000_000  # TimedTrajectory.sample: time samples of one call
 
 # Ipopt options an [ipopt.options] table may set: name -> float, int, or the allowed strings
