@@ -7,9 +7,10 @@ random configurations: coal distance and distance + exact gradient (bounding-cir
 phase, batches split over all cores by processes) and GraphDistNet distance and distance +
 ∂d̂/∂q (float32, ``--threads`` torch threads) by the torch reference path (``fused=False``)
 and by the fused kernels (``fused=True``: the whole-network pass of
-models/graphdistnet/fused_net.py for networks without node distances, else the ring-message
-kernels of models/graphdistnet/fused.py), best of the repeats
-after one warm-up call each, all six interleaved round by round.
+models/graphdistnet/fused_net.py for the networks it serves, all but two-way ones with node
+distances, else the ring-message kernels of models/graphdistnet/fused.py), best of the
+repeats after one warm-up call each, all six interleaved round by round. An ``--envs`` entry
+``env=WEIGHTS`` runs other weights on the scene (``d=results/ablation/d/soft-min-s0.safetensors``).
 
 FLOPs: the matmul FLOPs torch runs (FlopCounterMode) plus the fused kernels' products (2 R H²
 per hidden layer of the edge MLP on R edge rows, forward and backward; 2 n C H for the sparse
@@ -23,6 +24,7 @@ on this thread (thread CPU seconds too: the machine is shared, CPU time is what 
 still measures fairly).
 
     python benchmarks/inference.py --threads 1 [--n 5000] [--repeats 5] [--envs a b c d e fetch]
+        [--envs d d=results/ablation/d/soft-min-s0.safetensors …]
 """
 
 from __future__ import annotations
@@ -112,11 +114,14 @@ def coal_one_core(scene, q) -> None:
     distance.witness_gradient(scene, q, w)
 
 
-def row(table: common.Table, env: str, n: int, repeats: int, peak: float) -> None:
-    """One table row: seconds of coal and both GraphDistNet paths for n configurations."""
+def row(
+    table: common.Table, env: str, n: int, repeats: int, peak: float, name: str | None = None
+) -> None:
+    """One table row: seconds of coal and both GraphDistNet paths for n configurations, with
+    the weights ``name`` (a name or a file; None: the scene's shipped default)."""
     scene = gp.make_scene(env, seed=0)
     q = scene.robot.sample(n, seed=0)
-    name = default_weights(scene)
+    name = name or default_weights(scene)
     reference, fast = (gp.load_model(name) for _ in range(2))
     reference.fused, fast.fused = False, True
     distance.checker(scene)
@@ -175,8 +180,9 @@ def main() -> None:
         "fused d+grad pass GFLOP/s (share), CPU s",
         "coal d+grad on one core, CPU s; fused pass / it",
     )
-    for env in args.envs:
-        row(table, env, args.n, args.repeats, peak)
+    for entry in args.envs:  # env, or env=weights
+        env, _, name = entry.partition("=")
+        row(table, env, args.n, args.repeats, peak, name or None)
     report.write()
 
 

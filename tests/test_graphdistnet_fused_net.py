@@ -1,8 +1,9 @@
 """The whole-network pass of GraphDistNet (models/graphdistnet/fused_net.py) against the torch
 reference path (``fused=False``: autograd through :meth:`GraphDistNet.lean`).
 
-Every shipped weights file the pass serves (soft-kNN without node distances: one-way d, e;
-two-way b and ur5e, the planar fetch's), random and near-contact configurations, more than
+Every shipped weights file the pass serves (soft-kNN: one-way d, e; two-way b and ur5e, the
+planar fetch's; a and c are two-way with node distances, which the pass leaves to the
+ring-message kernels) and random one-way networks with node distances (each option), random and near-contact configurations, more than
 one tile. Float64: d̂ and ∂d̂/∂q agree to 1e-9 relative (the same
 function up to summation order). Float32 against a float64 truth: the yardstick is the
 reference's own float32 error. d̂ agrees with float64 to ~1e-6 m in both (asserted: 2e-6 ·
@@ -23,7 +24,12 @@ import pytest
 import torch
 
 import gdnplan as gp
-from gdnplan.models.graphdistnet import GraphDistNetModel, fused_net
+from gdnplan.models.graphdistnet import (
+    GraphDistNet,
+    GraphDistNetConfig,
+    GraphDistNetModel,
+    fused_net,
+)
 from gdnplan.models.graphdistnet import fused as fused_kernel
 
 SERVED = {"b": "b", "d": "d", "e": "e", "ur5e": "fetch"}  # weights the pass serves: scene
@@ -100,10 +106,14 @@ def test_whole_pass_float32_is_as_accurate_as_the_reference(weights):
     assert whole_err <= 3 * reference_err + 1e-6
 
 
-def test_whole_pass_serves_networks_without_node_distances():
+def test_whole_pass_serves_one_way_node_distances_not_two_way():
     names = ("a", "b", "c", "d", "e", "ur5e")
     served = {w for w in names if fused_net.serves(gp.load_model(w).config)}
-    assert served == set(SERVED)  # a and c have node distances: the ring-message kernels
+    assert served == set(SERVED)  # a and c: two-way with node distances, the ring-message kernels
+    one_way = GraphDistNetConfig(two_way=False, node_distance=True, min_readout=True)
+    assert fused_net.serves(one_way) == fused_kernel.AVAILABLE
+    assert not fused_net.serves(GraphDistNetConfig(two_way=True, node_distance=True))
+    assert not fused_net.serves(GraphDistNetConfig(mlp=(64, 64)))  # edge MLP wider than h
     scene = gp.make_scene("d", seed=0)
     assert gp.load_model("d")._graphs(scene).whole is not None or not fused_kernel.AVAILABLE
     reference = GraphDistNetModel(gp.load_model("d").net, fused=False)
@@ -125,3 +135,56 @@ def test_threads_split_the_batch_on_tiles_with_the_same_result():
     np.testing.assert_array_equal(single, one.distance(scene, q[:1]))
     # a batch of one runs other BLAS kernels (gemv-like shapes) than a full tile: float32 rounding
     np.testing.assert_allclose(single, d[:1], rtol=1e-6, atol=1e-7)
+
+
+DISTANCE_AWARE = {  # one-way networks with node distances: each option the pass computes
+    "node distances": {"node_distance": True},
+    "soft minimum": {"node_distance": True, "min_readout": True},
+    "probe points": {"node_distance": True, "min_readout": True, "probe_split": 3},
+    "band": {"node_distance": True, "min_readout": True, "probe_split": 2, "correction_band": 0.05},
+}
+
+
+def distance_aware(env: str, seed: int, **options) -> tuple[GraphDistNetModel, GraphDistNetModel]:
+    """Whole-pass and reference models (float64) of a random one-way network with ``options``,
+    every parameter non-trivial (the soft-minimum head's last layer starts at zero)."""
+    torch.manual_seed(seed)
+    scale = gp.make_scene(env, seed=0).robot.reach
+    net = GraphDistNet(GraphDistNetConfig(two_way=False, scale=scale, **options))
+    torch.nn.init.normal_(net.head[-1].weight, std=0.3)
+    card = {"env": env}
+    return (GraphDistNetModel(net, card=card, dtype=torch.float64, fused=f) for f in (True, False))
+
+
+@needs_numba
+@pytest.mark.parametrize("options", sorted(DISTANCE_AWARE))
+@pytest.mark.parametrize("env, seed", [("d", 0), ("e", 3), ("b", 11)])
+def test_whole_pass_equals_reference_with_node_distances(options, env, seed):
+    """Values and gradients of the distance-aware one-way networks, random and near-contact
+    configurations (inside obstacles too: negative node distances), more than one tile."""
+    scene = gp.make_scene(env, seed=seed)
+    whole, reference = distance_aware(env, seed, **DISTANCE_AWARE[options])
+    assert whole._graphs(scene).whole is not None
+    q = configurations(scene, n=96)
+    d, g = whole.distance_and_grad(scene, q)
+    d_ref, g_ref = reference.distance_and_grad(scene, q)
+    assert (gp.signed_distance(scene, q) < 0).any()  # penetrating configurations are in the set
+    np.testing.assert_allclose(d, d_ref, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(g, g_ref, rtol=1e-9, atol=1e-9 * np.abs(g_ref).max())
+    np.testing.assert_allclose(whole.distance(scene, q), d, rtol=1e-12, atol=1e-14)
+
+
+@needs_numba
+def test_whole_pass_gradient_with_node_distances_matches_finite_differences():
+    """The band network (every distance-aware term) against central differences of d̂ itself
+    (a step of 1e-7 rad: d̂ is piecewise smooth, and 1e-6 crosses a kink on these samples)."""
+    scene = gp.make_scene("d", seed=2)
+    whole, _ = distance_aware("d", 2, **DISTANCE_AWARE["band"])
+    q = configurations(scene, n=6, near=6)
+    _, g = whole.distance_and_grad(scene, q)
+    eps = 1e-7
+    for j in range(q.shape[1]):
+        step = np.zeros(q.shape[1])
+        step[j] = eps
+        fd = (whole.distance(scene, q + step) - whole.distance(scene, q - step)) / (2 * eps)
+        np.testing.assert_allclose(g[:, j], fd, rtol=1e-5, atol=1e-6)

@@ -61,8 +61,9 @@ prove it equal to :meth:`GraphDistNet.forward` (values and gradients). Where num
 (a core dependency), the edge MLP runs by the fused kernels of :mod:`.fused` instead, tile by
 tile in cache (and one-way cross terms over the candidates only); ``GraphDistNetModel(fused=…)``
 selects them (default: wherever they serve the network), tests prove them equal to the torch
-path on every shipped weights file. Networks without node distances (one-way or two-way) run
-whole in one compiled call (:mod:`.fused_net`).
+path on every shipped weights file. Networks without node distances (one-way or two-way) and
+one-way networks with them run whole in one compiled call (:mod:`.fused_net`,
+:mod:`.fused_net_distances`).
 
 Modules: :mod:`.config` (options), :mod:`.geometry` (candidates, ring distances),
 :mod:`.layers` (MLPs, readout softmax, ring messages), :mod:`.network` (the module and its

@@ -1,7 +1,8 @@
 """The whole GraphDistNet as one numba pass: d̂ and ∂d̂/∂nodes, tile by tile in cache.
 
-For soft-kNN networks without node distances (:func:`serves`) this module runs the network in
-one compiled call per batch: normalisation x = (p − origin) / scale, the C nearest partner
+For soft-kNN networks (:func:`serves`: one-way or two-way; node distances, their soft-minimum
+readout, probe points and band one-way, by :mod:`.fused_net_distances`) this module runs the
+network in one compiled call per batch: normalisation x = (p − origin) / scale, the C nearest partner
 nodes, and per layer k the soft weights, the first linear layer per node, the sparse cross
 mix, the edge MLP, the last linear layer, the attention readout and the running maximum, then
 the head; with the gradient, the hand-written backward of every step to the robot node
@@ -26,8 +27,11 @@ pre-activations kept as bytes), ∂u, ∂c → ∂z = [∂u, −∂c] A_kᵀ, th
 ∂c_i · V_k,j_c, then the softmax; two-way also ∂v_j_c += w_ic ∂c_i and ∂h_j_c⁽ᵏ⁻¹⁾ += ∂ℓ_ic
 a_{k−1}), ∂ℓ → ∂d²_ic (through −d²/τ_k and log φ, whose clamp passes no gradient) → the
 robot node of the pair += 2 (x_robot − x_obstacle) ∂d²_ic, and ∂p = ∂x / scale (obstacle
-nodes are constants). Products are BLAS calls on the tile (:func:`numpy.dot` in numba), the
-rest loops. The torch reference computes the same function
+nodes are constants). Distance-aware one-way networks add the node distance s_i w_k to c_i
+(so ∂s_i += ∂c_i · w_k) and, with ``min_readout``, the soft minimum m of the node and probe
+distances to the head (:mod:`.fused_net_distances`); ∂s then goes back to the nodes through
+the exact ring-distance gradient. Products are BLAS calls on the tile (:func:`numpy.dot` in
+numba), the rest loops. The torch reference computes the same function
 (tests/test_graphdistnet_fused_net.py).
 """
 
@@ -52,15 +56,15 @@ TILE_ROWS = 2048  # edge rows per tile, 3 n per configuration (docs/decisions.md
 
 
 def serves(config: GraphDistNetConfig) -> bool:
-    """Whether the whole-network kernel computes this network: soft-kNN, one-way or two-way,
-    no node distances (nor the soft-minimum readout that needs them), edge MLP hidden widths
-    all equal (:func:`.fused.supports`) and readout widths all equal (at least one hidden
-    layer in the head)."""
+    """Whether the whole-network kernel computes this network: soft-kNN, one-way or two-way
+    (node distances, with their soft-minimum readout, probe points and band: one-way only),
+    edge MLP hidden widths all equal (:func:`.fused.supports`) and readout widths all equal
+    (at least one hidden layer in the head)."""
     return (
         fused.supports(config.mlp)
         and config.cross == "soft_knn"
-        and not config.node_distance
-        and not config.min_readout
+        and config.mlp[0] == config.hidden
+        and not (config.node_distance and config.two_way)
         and len(config.readout) >= 1
         and len(set(config.readout)) == 1
     )
@@ -132,9 +136,12 @@ def pack(net, scene, dtype: np.dtype) -> PackedNetwork:
         score, v, ring = w0.new_zeros(c.layers, 0), w0.new_zeros(c.layers, 0, h), scene.ring
         cand = min(c.cross_k + 1, max(n_r, n_o))
     else:  # one-way: max_k y_o⁽ᵏ⁾ is a constant of the scene, folded into the head's bias
-        hb0 = hb0 + w0[:, h:] @ fixed.readout.double().amax(0)
-        w0, score, v, ring = w0[:, :h], fixed.score, fixed.v, scene.robot_ring
+        hb0 = hb0 + w0[:, h : 2 * h] @ fixed.readout.double().amax(0)
+        score, v, ring = fixed.score, fixed.v, scene.robot_ring
         cand = min(c.cross_k + 1, n_o)
+    hm = w0[:, 2 * h] if c.min_readout else w0.new_zeros(0)  # the soft minimum's column
+    w0 = w0 if fixed is None else w0[:, :h]
+    din = net.distance_in.double() if c.node_distance else w0.new_zeros(c.layers, 0)
     hw = torch.stack([m.weight for m in head[1:-1]]) if len(head) > 2 else w0.new_zeros(0, 1, 1)
     hb = torch.stack([m.bias for m in head[1:-1]]) if len(head) > 2 else w0.new_zeros(0, 1)
     whs, wls, ahs = torch.stack(wh), torch.stack(wl), torch.stack(ah)
@@ -166,6 +173,12 @@ def pack(net, scene, dtype: np.dtype) -> PackedNetwork:
         blast=head[-1].bias,
         scale=np.dtype(dtype).type(c.scale),
         slope=np.dtype(dtype).type(LEAKY_SLOPE),
+        onext=np.ascontiguousarray(scene.obstacle_next.cpu().numpy().astype(np.int64)),
+        probe=c.probe_split,
+        din=din,
+        hm=hm,
+        tau_min=np.dtype(dtype).type(net.log_tau_min.exp().item() if c.min_readout else 1.0),
+        band=np.dtype(dtype).type(c.correction_band or 0.0),
     )
     tensors = {k: _np(t, dtype) for k, t in arrays._asdict().items() if isinstance(t, torch.Tensor)}
     return PackedNetwork(arrays._replace(**tensors), np.asarray(c.origin, dtype), c.scale, cand)

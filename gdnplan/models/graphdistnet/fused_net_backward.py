@@ -14,17 +14,24 @@ from .fused import AVAILABLE
 
 if AVAILABLE:
     from .fused import _jit, _log_phi_backward
+    from .fused_net_distances import points_backward
+    from .fused_net_distances import readout as _distance_readout
     from .gemm import mm
 
     @_jit
-    def _head_backward(net, st, t_n):
-        """(T, P) ∂d̂/∂pooled: the head's layers in reverse."""
+    def _head_backward(net, st, t_n, gs):
+        """(T, P) ∂d̂/∂pooled: the head's layers in reverse; with ``min_readout`` also gs
+        (T, points) += ∂d̂/∂s through the soft minimum (the head's input and the readout)."""
         hl = net.hw.shape[0]
         r = net.wlast.shape[0]
         g = np.empty((t_n, r), st.xu.dtype)
+        direct = np.zeros(t_n, st.xu.dtype)  # ∂d̂/∂m past the head
         for t in range(t_n):
+            dy = net.scale
+            if net.hm.shape[0]:
+                _, dy, direct[t] = _distance_readout(net, st.m[t], st.y[t])
             for o in range(r):
-                gv = net.wlast[o] * net.scale
+                gv = net.wlast[o] * dy
                 g[t, o] = gv if st.hmask[hl, t, o] else gv * net.slope
         for layer in range(hl - 1, -1, -1):
             g = mm(g, net.hw[layer])
@@ -32,6 +39,13 @@ if AVAILABLE:
                 for o in range(r):
                     if not st.hmask[layer, t, o]:
                         g[t, o] *= net.slope
+        if net.hm.shape[0]:
+            for t in range(t_n):
+                dm = direct[t]
+                for o in range(r):
+                    dm += g[t, o] * net.hm[o]
+                for p in range(gs.shape[1]):
+                    gs[t, p] += dm * st.sw[t, p]
         return mm(g, net.h0)
 
     @_jit
@@ -165,7 +179,8 @@ if AVAILABLE:
         layers, h = net.att.shape
         rows = t_n * n
         two_way = n > n_r
-        dy = _head_backward(net, st, t_n)  # (T, P)
+        gs = np.zeros((t_n, st.s.shape[1]), x.dtype)  # ∂d̂/∂s of the distance points
+        dy = _head_backward(net, st, t_n, gs)  # (T, P)
         dh = np.zeros((rows, h), x.dtype)  # ∂/∂h⁽ᵏ⁾ from the layers above
         dlphi = np.zeros((t_n, n, cand), x.dtype)
         dnear = np.zeros((t_n, n, cand), x.dtype)
@@ -173,6 +188,13 @@ if AVAILABLE:
         for k in range(layers - 1, -1, -1):
             _readout_backward(net, st, k, t_n, n_r, dy, dh)
             duv, dc = _edge_backward(net, st, k, t_n, dh)
+            if net.din.shape[1]:  # c_i holds s_i w_k (one-way: robot rows only)
+                for t in range(t_n):
+                    for i in range(n):
+                        acc = net.scale * 0
+                        for o in range(h):
+                            acc += dc[t * n + i, o] * net.din[k, o]
+                        gs[t, i] += acc
             dscore[:] = 0
             _cross_backward(net, st, k, t_n, two_way, duv, dc, dlphi, dnear, dscore)
             for t in range(t_n):  # ∂x from z = (x ‖ h) (robot rows: obstacles are constants)
@@ -189,3 +211,5 @@ if AVAILABLE:
                         for o in range(h):
                             dh[r, o] += dscore[r] * net.att[k - 1, o]
         _candidates_backward(net, st, t_n, n_r, dlphi, dnear, g_out)
+        if gs.shape[1]:
+            points_backward(net, gs, st.ds, g_out)

@@ -7,7 +7,8 @@ gradient :func:`.fused_net_backward._backward_tile` runs the reverse pass at onc
 network's arrays travel as one :class:`Net`. Shapes: T configurations per tile, n union rows
 per configuration (the N_r robot nodes, then for two-way networks the N_o obstacle nodes),
 C candidates, K layers, H features, P = H (one-way) or 2 H (two-way) pooled features, L
-hidden layers of the edge MLP, R readout width.
+hidden layers of the edge MLP, R readout width, P distance points per configuration (0
+without node distances; :mod:`.fused_net_distances`).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ NO_WEIGHT = -1e30  # log φ of a padded candidate: weight exp(−1e30) = 0 (fini
 Net = namedtuple(
     "Net",
     "xo ring tau score v ax ah aht b1 wht wh bh wlt wl bl3 att h0t h0 hb0 hwt hw hb wlast blast "
-    "scale slope",
+    "scale slope onext probe din hm tau_min band",
 )
 Net.__doc__ = """The network and one scene's constants (:func:`.fused_net.pack`): xo (M, 2)
 obstacle nodes, ring (2, n) prev/next union rows, tau (K,), one-way partner terms score
@@ -32,19 +33,26 @@ obstacle nodes, ring (2, n) prev/next union rows, tau (K,), one-way partner term
 (K, H, 2H), aht = ahᵀ, b1 (K, H), edge MLP wht / wh (K, L, H, H) (transposed / not), bh
 (K, L, H), last layer wlt / wl (K, H, H), bl3 (K, H) = 3 b_L, att (K, H), head h0t (P, R), h0
 (R, P), hb0 (R,), hwt / hw (Lr, R, R), hb (Lr, R), wlast (R,), blast (1,), scale and the
-LeakyReLU slope (scalars of the dtype)."""
+LeakyReLU slope (scalars of the dtype); distance-aware one-way networks: onext (M,) the
+obstacle rings' successors, probe = ``probe_split`` (int), din (K, H) the node distances'
+weights w_k (K, 0 without), hm (R,) the head's column of the soft minimum (0 without
+``min_readout``), tau_min and band β (0: none) scalars."""
 
-State = namedtuple("State", "xu idx near lphi w v h mask logit alpha ypos src hmask")
+State = namedtuple("State", "xu idx near lphi w v h mask logit alpha ypos src hmask s ds sw m y")
 State.__doc__ = """Per tile: xu (T, n, 2) union coordinates, idx / near / lphi (T, n, C)
 candidates (partner rows, d², log φ), w (K, T, n, C) soft weights, v (K, T n, H) two-way
 partner terms (one-way: no rows), h (K, T n, H) features, mask (K, L + 1, 3 T n, H) signs of
 the edge pre-activations, logit / alpha (K, T, n) readout scores and weights, ypos (K, T, P)
 signs of the readouts, src (T, P) the layer of each pooled maximum, hmask (Lr + 1, T, R)
-signs of the head's pre-activations."""
+signs of the head's pre-activations; s / ds / sw (T, P), (T, P, 2), (T, P) the points'
+distances, gradients and soft-minimum weights, m / y (T,) the soft minimum and the head's
+output."""
 
 if AVAILABLE:
     from .fused import _jit, _leaky_rows, _softmax_inplace
     from .fused_net_backward import _backward_tile
+    from .fused_net_distances import readout as _distance_readout
+    from .fused_net_distances import soft_min, tile_distances
     from .gemm import mm
 
     @_jit
@@ -132,6 +140,9 @@ if AVAILABLE:
                 r = t * n + i
                 for o in range(h):
                     cc[r, o] = net.b1[k, o] - uv[r, h + o]
+                if net.din.shape[1]:  # one-way: every row is a robot node, s_i its distance
+                    for o in range(h):
+                        cc[r, o] += st.s[t, i] * net.din[k, o]
                 for c in range(cand):  # a partner's row at a time: contiguous, vectorised
                     row = base + st.idx[t, i, c]
                     wc = w[t, i, c]
@@ -223,6 +234,8 @@ if AVAILABLE:
         layers = net.att.shape[0]
         two_way = net.ring.shape[1] > n_r
         _candidates(x, net, st)
+        if net.din.shape[1]:
+            tile_distances(x, net, st.s, st.ds)
         pooled = np.empty((t_n, net.h0t.shape[0]), x.dtype)
         for k in range(layers):
             _soft_weights(net, st, k, t_n, two_way)
@@ -230,6 +243,11 @@ if AVAILABLE:
             _edge_mlp(net, st, k, t_n, uv, cc)
             _readout(net, st, k, t_n, n_r, pooled)
         a = mm(pooled, net.h0t)  # the head (one-way: its obstacle half is in hb0)
+        if net.hm.shape[0]:  # min_readout: the soft minimum is the head's last input
+            for t in range(t_n):
+                st.m[t] = soft_min(net, st.s[t], st.sw[t])
+                for o in range(a.shape[1]):
+                    a[t, o] += st.m[t] * net.hm[o]
         _leaky_rows(a, net.hb0, st.hmask[0], net.slope)
         for layer in range(net.hwt.shape[0]):
             a = mm(a, net.hwt[layer])
@@ -238,7 +256,11 @@ if AVAILABLE:
             out = net.blast[0]
             for o in range(a.shape[1]):
                 out += a[t, o] * net.wlast[o]
-            d_out[t] = out * net.scale
+            st.y[t] = out
+            if net.hm.shape[0]:  # min_readout: d̂ = scale · (m + y), or banded
+                d_out[t] = _distance_readout(net, st.m[t], out)[0]
+            else:
+                d_out[t] = out * net.scale
 
     @_jit
     def network(x, net, cand, d_out, g_out, tile):
@@ -249,6 +271,7 @@ if AVAILABLE:
         layers, h = net.att.shape
         dt = x.dtype
         hidden, width = net.wht.shape[1], net.h0t.shape[0]
+        points = n_r * net.probe if net.din.shape[1] else 0
         st = State(
             np.empty((tile, n, 2), dt),
             np.empty((tile, n, cand), np.int64),
@@ -263,6 +286,11 @@ if AVAILABLE:
             np.empty((layers, tile, width), np.bool_),
             np.empty((tile, width), np.int64),
             np.empty((net.hw.shape[0] + 1, tile, net.wlast.shape[0]), np.bool_),
+            np.empty((tile, points), dt),
+            np.empty((tile, points, 2), dt),
+            np.empty((tile, points), dt),
+            np.empty(tile, dt),
+            np.empty(tile, dt),
         )
         for b0 in range(0, bsz, tile):
             b1 = min(b0 + tile, bsz)

@@ -47,7 +47,7 @@ class GraphDistNetModel:
     torch reference (:class:`~.layers._LeakyRingMessages`), None (default) the fused kernels
     where they serve the network, else the reference. The two compute the same function
     (tests/test_graphdistnet_fused.py). With the fused kernels, networks that
-    :func:`.fused_net.serves` (no node distances, one-way or two-way) run whole in one
+    :func:`.fused_net.serves` (one-way or two-way; node distances one-way) run whole in one
     compiled pass (:mod:`.fused_net`: d̂ and ∂d̂/∂nodes without torch;
     tests/test_graphdistnet_fused_net.py).
     """
