@@ -2,8 +2,8 @@
 
 For soft-kNN networks (:func:`serves`: one-way or two-way; node distances, their soft-minimum
 readout, probe points and band one-way, by :mod:`.fused_net_distances`) this module runs the
-network in one compiled call per batch: normalisation x = (p − origin) / scale, the C nearest partner
-nodes, and per layer k the soft weights, the first linear layer per node, the sparse cross
+network in one compiled call per batch: normalisation x = (p − origin) / scale, the C nearest
+partner nodes, and per layer k the soft weights, the first linear layer per node, the sparse cross
 mix, the edge MLP, the last linear layer, the attention readout and the running maximum, then
 the head; with the gradient, the hand-written backward of every step to the robot node
 positions p (B, N_r, 2), tile by tile right after the tile's forward (its activations still in

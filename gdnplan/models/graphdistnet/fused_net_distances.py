@@ -29,30 +29,47 @@ if AVAILABLE:
     from .fused import _jit
 
     @_jit
-    def _ring_distance(p0, p1, xo, onext):
-        """(s, ∂s/∂p0, ∂s/∂p1) of the point (p0, p1) to the rings xo (M, 2), onext (M,)."""
-        best, bx, by = PAD_DIST2 + p0 * 0, p0 * 0, p0 * 0
-        winding = 0
+    def _ring_distances(px, py, xo, onext, s, gx, gy):
+        """s, gx, gy (n,) ← the signed distances of the points (px, py) (n,) to the rings xo
+        (M, 2), onext (M,), and their gradients. Edge by edge over all points (contiguous: the
+        inner loop vectorises): the smallest δ², its edge and the winding number; then the
+        nearest edge's offset again per point."""
+        n = px.shape[0]
+        zero = px[0] * 0 if n else xo[0, 0] * 0  # constants of the dtype (literals promote)
+        one = zero + 1
+        best = np.full(n, zero + PAD_DIST2)
+        arg = np.zeros(n, np.int64)
+        winding = np.zeros(n, np.int64)
         for m in range(xo.shape[0]):
             ax, ay = xo[m, 0], xo[m, 1]
             ex, ey = xo[onext[m], 0] - ax, xo[onext[m], 1] - ay
-            wx, wy = p0 - ax, p1 - ay
-            t = (wx * ex + wy * ey) / max(ex * ex + ey * ey, 1e-12)
-            t = min(max(t, 0.0), 1.0)
-            rx, ry = wx - t * ex, wy - t * ey
-            d2 = rx * rx + ry * ry
-            if d2 < best:
-                best, bx, by = d2, rx, ry
-            left = ex * wy - ey * wx
-            if wy >= 0 and wy < ey and left > 0:
-                winding += 1
-            elif wy < 0 and wy >= ey and left < 0:
-                winding -= 1
-        sign = -1.0 if winding != 0 else 1.0
-        if best < 1e-12:  # sqrt(clamp(δ², 1e-12)): no gradient below the floor
-            return sign * 1e-6, p0 * 0, p0 * 0
-        dist = np.sqrt(best)
-        return sign * dist, sign * bx / dist, sign * by / dist
+            inv = one / max(ex * ex + ey * ey, zero + 1e-12)
+            for p in range(n):
+                wx, wy = px[p] - ax, py[p] - ay
+                t = min(max((wx * ex + wy * ey) * inv, zero), one)
+                rx, ry = wx - t * ex, wy - t * ey
+                d2 = rx * rx + ry * ry
+                closer = d2 < best[p]
+                best[p] = d2 if closer else best[p]
+                arg[p] = m if closer else arg[p]
+                left = ex * wy - ey * wx
+                up = (wy >= zero) & (wy < ey) & (left > zero)
+                down = (wy < zero) & (wy >= ey) & (left < zero)
+                winding[p] += np.int64(up) - np.int64(down)
+        for p in range(n):
+            m = arg[p]
+            sign = -one if winding[p] != 0 else one
+            if best[p] < 1e-12:  # sqrt(clamp(δ², 1e-12)): no gradient below the floor
+                s[p], gx[p], gy[p] = sign * (one * 1e-6), zero, zero
+                continue
+            ax, ay = xo[m, 0], xo[m, 1]
+            ex, ey = xo[onext[m], 0] - ax, xo[onext[m], 1] - ay
+            wx, wy = px[p] - ax, py[p] - ay
+            t = min(max((wx * ex + wy * ey) / max(ex * ex + ey * ey, zero + 1e-12), zero), one)
+            dist = np.sqrt(best[p])
+            s[p] = sign * dist
+            gx[p] = sign * (wx - t * ex) / dist
+            gy[p] = sign * (wy - t * ey) / dist
 
     @_jit
     def tile_distances(x, net, s, ds):
@@ -60,17 +77,25 @@ if AVAILABLE:
         probes) and their gradients by the point's coordinates."""
         t_n, n_r, _ = x.shape
         split = net.probe
+        cols = n_r * split
+        px = np.empty(t_n * cols, x.dtype)
+        py = np.empty(t_n * cols, x.dtype)
         for t in range(t_n):
             for i in range(n_r):
+                nx = net.ring[1, i]
                 for j in range(split):
                     f = j / split
-                    nx = net.ring[1, i]
-                    p0 = x[t, i, 0] + f * (x[t, nx, 0] - x[t, i, 0])
-                    p1 = x[t, i, 1] + f * (x[t, nx, 1] - x[t, i, 1])
-                    col = i if j == 0 else n_r + i * (split - 1) + j - 1
-                    s[t, col], ds[t, col, 0], ds[t, col, 1] = _ring_distance(
-                        p0, p1, net.xo, net.onext
-                    )
+                    col = t * cols + (i if j == 0 else n_r + i * (split - 1) + j - 1)
+                    px[col] = x[t, i, 0] + f * (x[t, nx, 0] - x[t, i, 0])
+                    py[col] = x[t, i, 1] + f * (x[t, nx, 1] - x[t, i, 1])
+        flat = s[:t_n].reshape(-1)  # (T P) views of the outputs
+        gx = np.empty(t_n * cols, x.dtype)
+        gy = np.empty(t_n * cols, x.dtype)
+        _ring_distances(px, py, net.xo, net.onext, flat, gx, gy)
+        for t in range(t_n):
+            for c in range(cols):
+                ds[t, c, 0] = gx[t * cols + c]
+                ds[t, c, 1] = gy[t * cols + c]
 
     @_jit
     def soft_min(net, s, weights):
