@@ -192,13 +192,24 @@ def score(weights: Path, env: str, s: Settings) -> dict:
     out = {
         "mae": test["mae_m"], "auc": test["auc"], "acd": test["acd"], "n_test": test["n"],
         "seconds": card["training"]["seconds"], "epochs": card["training"]["epochs"],
-        "grad_time": grad_time(model, scene, s.timing_batch),
         "sweep_max": sweep_max(model, scene, s.sweeps, s.sweep_steps),
-    }  # fmt: skip
+    } | timing(weights, env, s)  # fmt: skip
     if s.table2 and env in TABLE2_SETTINGS:
         out["t2_success"], out["t2_median"], out["t2_cpu"] = table2_ipopt(model, env, s.table2)
         out["t2_n"], out["t2_git"] = s.table2, git_sha()  # the planner that solved them
     return out
+
+
+def timing(weights: Path, env: str, s: Settings) -> dict:
+    """The d̂+∇ column of one trained step (:func:`grad_time`) and the code that measured it
+    (``time_git``: the inference kernels change under kept steps; ``--retime`` measures
+    again)."""
+    from .models import load_model
+    from .scene import make_scene
+
+    model = load_model(weights, threads=1)
+    return {"grad_time": grad_time(model, make_scene(env, seed=11), s.timing_batch),
+            "time_git": git_sha()}  # fmt: skip
 
 
 def _weights_path(runs: Path, env: str, step: int, seed: int) -> Path:
@@ -233,10 +244,12 @@ def run(
     runs: Path | str = RUNS_DIR,
     log: Callable[[str], None] = print,
     train_for: float = math.inf,
+    retime: bool = False,
 ) -> dict[str, list[list[dict]]]:
     """{env: [[scores of each trained seed] for each step]}, training and scoring what is
     missing. No step starts training once ``train_for`` seconds (wall) have passed (0: report
-    the kept steps only); steps left untrained have fewer seeds' scores, or none."""
+    the kept steps only); steps left untrained have fewer seeds' scores, or none. ``retime``:
+    the d̂+∇ column of every kept step is measured again with this code (:func:`timing`)."""
     s = s or Settings()
     data_root, runs = Path(data_root), Path(runs)
     deadline = time.monotonic() + train_for
@@ -255,6 +268,9 @@ def run(
                 cached = weights.with_suffix(".scores.json")
                 if not cached.exists():
                     cached.write_text(json.dumps(score(weights, env, s), indent=1) + "\n")
+                elif retime:
+                    scores = json.loads(cached.read_text()) | timing(weights, env, s)
+                    cached.write_text(json.dumps(scores, indent=1) + "\n")
                 log(f"ablation {env} {STEPS[step][0]} seed {seed}: {cached.read_text()}")
     return {env: [_kept_scores(runs, env, step, seeds) for step in range(len(STEPS))]
             for env in envs}  # fmt: skip
@@ -300,19 +316,29 @@ def markdown(results: dict[str, list[list[dict]]], s: Settings) -> str:
                 f"({'/'.join(str(r['epochs']) for r in runs)}) |"
             )
     n_test = sorted({r["n_test"] for steps in results.values() for runs in steps for r in runs})
-    return "\n".join(lines) + "\n" + notes(s, "/".join(map(str, n_test))) + _planners(results)
+    return (
+        "\n".join(lines) + "\n" + notes(s, "/".join(map(str, n_test)))
+        + _versions(results, "t2_git", "Table II rows were solved by", "planner",
+                    "delete the `.scores.json` files to re-score")
+        + _versions(results, "time_git", "d̂+∇ was measured by", "code",
+                    "`--retime` measures every kept step again")
+    )  # fmt: skip
 
 
-def _planners(results: dict[str, list[list[dict]]]) -> str:
-    """A note naming the planner versions of the Table II column when its rows were solved by
-    more than one (``t2_git``; rows scored before it was recorded: "before t2_git")."""
-    shas = {r["t2_git"][:7] if "t2_git" in r else "before t2_git" for steps in results.values()
-            for runs in steps for r in runs if "t2_success" in r}  # fmt: skip
+def _versions(
+    results: dict[str, list[list[dict]]], key: str, lead: str, what: str, fix: str
+) -> str:
+    """A note naming the code versions (``key``: a git SHA in the scores; rows scored before it
+    was recorded: "before <key>") behind a column when there is more than one."""
+    column = "t2_success" if key == "t2_git" else "grad_time"
+    shas = {r[key][:7] if key in r else f"before {key}" for steps in results.values()
+            for runs in steps for r in runs if column in r}  # fmt: skip
     if len(shas) < 2:
         return ""
+    versions = ", ".join(sorted(shas))
     return (
-        f"Table II rows were solved by {len(shas)} planner versions ({', '.join(sorted(shas))}"
-        "): compare them within one version; delete the `.scores.json` files to re-score.\n"
+        f"{lead} {len(shas)} {what} versions ({versions}): compare them within one version; "
+        f"{fix}.\n"
     )
 
 

@@ -148,6 +148,36 @@ def test_the_table_says_when_table_ii_rows_come_from_different_planners():
     assert "2 planner versions (bbbbbbb, before t2_git)" in note
 
 
+def test_the_table_says_when_timings_come_from_different_code():
+    row = {"mae": 0.01, "auc": 0.99, "acd": 0.2, "n_test": 10, "seconds": 1.0, "epochs": 1,
+           "grad_time": 1e-4, "sweep_max": 0.01}  # fmt: skip
+    empty = [[] for _ in ablation.STEPS[2:]]
+    same = {"b": [[row | {"time_git": "a" * 40}], [row | {"time_git": "a" * 40}], *empty]}
+    assert "code versions" not in ablation.markdown(same, ablation.Settings())
+    mixed = {"b": [[row], [row | {"time_git": "c" * 40}], *empty]}
+    note = ablation.markdown(mixed, ablation.Settings())
+    assert "d̂+∇ was measured by 2 code versions (before time_git, ccccccc)" in note
+    assert "--retime" in note
+
+
+def test_retime_measures_kept_steps_again_and_keeps_the_rest(tmp_path, monkeypatch):
+    """``retime``: every kept step's d̂+∇ and its code version are replaced, the other
+    columns stay; without it the kept scores are not touched."""
+    runs = tmp_path / "runs"
+    weights = runs / "b" / "faithful-s0.safetensors"
+    weights.parent.mkdir(parents=True)
+    weights.write_bytes(b"")
+    cached = weights.with_suffix(".scores.json")
+    cached.write_text(json.dumps({"mae": 0.01, "grad_time": 9.0}))
+    monkeypatch.setattr(ablation, "timing", lambda w, env, s: {"grad_time": 1e-4, "time_git": "x"})
+    root = tmp_path / "data"
+    ablation.run(("b",), 1, ablation.Settings(), root, runs, log=lambda m: None, train_for=0)
+    assert json.loads(cached.read_text()) == {"mae": 0.01, "grad_time": 9.0}
+    ablation.run(("b",), 1, ablation.Settings(), root, runs, log=lambda m: None, train_for=0,
+                 retime=True)  # fmt: skip
+    assert json.loads(cached.read_text()) == {"mae": 0.01, "grad_time": 1e-4, "time_git": "x"}
+
+
 def test_ablation_figure_plots_means_gaps_and_refuses_a_wrong_shape():
     """Two seeds: the MAE point is their mean (mm) with the standard error as its bar; an
     untrained step is a gap (NaN); a results dict with another step count is refused."""

@@ -206,6 +206,9 @@ def ablation_command(
     figure: Path = typer.Option(
         None, help="Also plot the columns over the steps (.png, .pdf, .svg)."
     ),
+    retime: bool = typer.Option(
+        False, "--retime", help="Measure every kept step's d̂+∇ again with this code."
+    ),
 ) -> None:
     """Faithful → soft partners → one-way → node distances → soft-minimum readout → probe
     points → band readout, one change a step, same data, budget and seeds (resumable)."""
@@ -238,8 +241,9 @@ def ablation_command(
                         generate(env, n, seed, target, workers=1)
         limit = float("inf") if train_for is None else train_for
         results = ablation.run(
-            chosen, seeds, s, root, runs, log=lambda m: typer.echo(m, err=True), train_for=limit
-        )
+            chosen, seeds, s, root, runs, log=lambda m: typer.echo(m, err=True),
+            train_for=limit, retime=retime,
+        )  # fmt: skip
     command = (
         f"gdnplan reproduce ablation{' --fast' if fast else ''} --envs {','.join(chosen)} "
         f"--seeds {seeds}" + ("" if fast else f" --budget {budget:g}")
