@@ -25,6 +25,7 @@ checkpoint.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import time
@@ -196,8 +197,15 @@ def score(weights: Path, env: str, s: Settings) -> dict:
     } | timing(weights, env, s)  # fmt: skip
     if s.table2 and env in TABLE2_SETTINGS:
         out["t2_success"], out["t2_median"], out["t2_cpu"] = table2_ipopt(model, env, s.table2)
-        out["t2_n"], out["t2_git"] = s.table2, git_sha()  # the planner that solved them
+        out["t2_n"], out["t2_git"] = s.table2, loaded_code()  # the planner that solved them
     return out
+
+
+@functools.cache
+def loaded_code() -> str:
+    """The commit checked out when this process first asked (its run's start): the code it
+    loaded, not a commit made while it ran (:func:`~.train.git_sha` at the time of asking)."""
+    return git_sha()
 
 
 def timing(weights: Path, env: str, s: Settings) -> dict:
@@ -209,7 +217,7 @@ def timing(weights: Path, env: str, s: Settings) -> dict:
 
     model = load_model(weights, threads=1)
     return {"grad_time": grad_time(model, make_scene(env, seed=11), s.timing_batch),
-            "time_git": git_sha()}  # fmt: skip
+            "time_git": loaded_code()}  # fmt: skip
 
 
 def _weights_path(runs: Path, env: str, step: int, seed: int) -> Path:
@@ -251,6 +259,7 @@ def run(
     the kept steps only); steps left untrained have fewer seeds' scores, or none. ``retime``:
     the d̂+∇ column of every kept step is measured again with this code (:func:`timing`)."""
     s = s or Settings()
+    loaded_code()  # the code of this run, before any commit made while it trains
     data_root, runs = Path(data_root), Path(runs)
     deadline = time.monotonic() + train_for
     for env in envs:
