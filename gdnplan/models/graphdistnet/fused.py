@@ -81,6 +81,9 @@ def _tile(n: int) -> int:
 
 
 if AVAILABLE:
+    from .kernel_cache import purge_stale
+
+    purge_stale()  # before any cached kernel loads: numba keys its cache on one file only
     from .gemm import mm
 
     _jit = numba.njit(cache=True, fastmath=True, nogil=True)

@@ -15,7 +15,8 @@ The point list of a configuration is the N_r nodes, then the probes node by node
 ``min_readout``: m = −τ_m log Σ_p exp(−s_p / τ_m) (∂m/∂s_p = softmax_p(−s/τ_m)) joins the
 head's first layer (its column ``hm``), and d̂ = scale · (m + y) for the head's output y, or
 with ``correction_band`` β: d̂ = scale · (m + g (y − m)), g = σ(8 (1 − scale · m / β)),
-∂d̂/∂y = scale g, ∂d̂/∂m (direct) = scale (1 − g + (y − m) g'), g' = −8 scale / β · g (1 − g).
+∂d̂/∂y = scale g, ∂d̂/∂m (direct) = scale (1 − g + (y − m) g'), g' = −8 scale / β · g (1 − g);
+below g = :data:`GATE_FLOOR` the head passes no gradient (∂d̂/∂y = 0, ∂d̂/∂m = scale).
 """
 
 from __future__ import annotations
@@ -24,6 +25,9 @@ import numpy as np
 
 from .fused import AVAILABLE
 from .geometry import PAD_DIST2
+
+GATE_FLOOR = 1e-12  # a band gate g below this passes no gradient through the head: far from
+# contact g ≈ exp(−8 scale m / β) underflows, and products of denormal floats are ~100× slower
 
 if AVAILABLE:
     from .fused import _jit
@@ -120,8 +124,11 @@ if AVAILABLE:
         if net.band <= 0:
             return scale * (m + y), scale, scale
         g = 1 / (1 + np.exp(-8 * (1 - scale * m / net.band)))
+        d = scale * (m + g * (y - m))
+        if g < GATE_FLOOR:  # the head's gradient would be denormal: 0 (and the backward fast)
+            return d, scale * 0, scale
         dg = -8 * scale / net.band * g * (1 - g)
-        return scale * (m + g * (y - m)), scale * g, scale * (1 - g + (y - m) * dg)
+        return d, scale * g, scale * (1 - g + (y - m) * dg)
 
     @_jit
     def points_backward(net, gs, ds, g_out):

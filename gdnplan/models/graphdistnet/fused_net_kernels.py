@@ -140,25 +140,15 @@ if AVAILABLE:
                 r = t * n + i
                 for o in range(h):
                     cc[r, o] = net.b1[k, o] - uv[r, h + o]
+                if net.din.shape[1]:  # one-way: every row is a robot node, s_i its distance
+                    for o in range(h):
+                        cc[r, o] += st.s[t, i] * net.din[k, o]
                 for c in range(cand):  # a partner's row at a time: contiguous, vectorised
                     row = base + st.idx[t, i, c]
                     wc = w[t, i, c]
                     for o in range(h):
                         cc[r, o] += wc * partners[row, o]
-        if net.din.shape[1]:  # one-way: every row is a robot node, s_i its distance
-            _add_distance_term(cc, st.s, net.din[k], t_n, n)
         return uv, cc
-
-    @_jit
-    def _add_distance_term(cc, s, w, t_n, n):
-        """cc (T n, H) += s_i w of the tile's rows (s (T, ≥ n), w (H,)): its own loop, so
-        the partner loop above stays vectorised."""
-        for t in range(t_n):
-            for i in range(n):
-                si = s[t, i]
-                r = t * n + i
-                for o in range(w.shape[0]):
-                    cc[r, o] += si * w[o]
 
     @_jit
     def _edge_mlp(net, st, k, t_n, uv, cc):
