@@ -247,6 +247,9 @@ def network_line(card: dict) -> str:
         "random (one per graph), then argmax partners",
         "two-way cross edges" if net.two_way else "one-way cross edges",
     ]  # fmt: skip
+    default = type(net)()
+    if (net.layers, net.hidden) != (default.layers, default.hidden):  # lines stay short otherwise
+        parts.append(f"{net.layers} layers of {net.hidden} features")
     if net.node_distance:
         parts.append("node distances")
     if net.min_readout:

@@ -108,6 +108,11 @@ def test_network_line_names_the_architecture_and_loss():
     line = ev.network_line(card)
     assert line.startswith("random (one per graph), then argmax partners, two-way cross edges;")
     assert "loss: distance + gradient λ = 0.1; 36 000 training samples; 12 s" in line
+    assert "layers of" not in line  # the default size goes unsaid
+    small = {**card, "config": {"layers": 2, "hidden": 16, "mlp": [16, 16], "readout": [16]}}
+    assert ev.network_line(small).startswith(
+        "soft nearest-node partners, two-way cross edges, 2 layers of 16 features;"
+    )
 
 
 def test_fig5_panels_and_detour_path_is_free():
