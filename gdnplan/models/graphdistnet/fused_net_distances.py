@@ -45,8 +45,8 @@ if AVAILABLE:
         arg = np.zeros(n, np.int64)
         winding = np.zeros(n, np.int64)
         for m in range(xo.shape[0]):
-            ax, ay = xo[m, 0], xo[m, 1]
-            ex, ey = xo[onext[m], 0] - ax, xo[onext[m], 1] - ay
+            ax, ay, by = xo[m, 0], xo[m, 1], xo[onext[m], 1]
+            ex, ey = xo[onext[m], 0] - ax, by - ay
             inv = one / max(ex * ex + ey * ey, zero + 1e-12)
             for p in range(n):
                 wx, wy = px[p] - ax, py[p] - ay
@@ -56,9 +56,9 @@ if AVAILABLE:
                 closer = d2 < best[p]
                 best[p] = d2 if closer else best[p]
                 arg[p] = m if closer else arg[p]
-                left = ex * wy - ey * wx
-                up = (wy >= zero) & (wy < ey) & (left > zero)
-                down = (wy < zero) & (wy >= ey) & (left < zero)
+                left = ex * wy - ey * wx  # a_y ≤ p_y < b_y by the coordinates themselves
+                up = (ay <= py[p]) & (py[p] < by) & (left > zero)
+                down = (by <= py[p]) & (py[p] < ay) & (left < zero)
                 winding[p] += np.int64(up) - np.int64(down)
         for p in range(n):
             m = arg[p]

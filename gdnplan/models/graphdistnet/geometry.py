@@ -89,9 +89,12 @@ def signed_ring_distance(
 
     s_p = ± min_m δ_pm, negative where p is inside a ring (non-zero winding number: edges
     crossing the ray p + λ x̂, λ > 0, counted +1 upwards with p on their left, −1 downwards
-    with p on their right). s is continuous in p and in the nodes (the sign switches where
-    min δ = 0); masked edges are left out. Between two apart polygons the distance is the
-    smallest |s| over the vertices of both, since a closest pair has a vertex at one end.
+    with p on their right; an edge crosses when a_y ≤ p_y < b_y or b_y ≤ p_y < a_y, the
+    coordinates compared as they are, so that two edges sharing a vertex agree on which side
+    of it p lies even when p_y is within rounding of the vertex's). s is continuous in p and
+    in the nodes (the sign switches where min δ = 0); masked edges are left out. Between two
+    apart polygons the distance is the smallest |s| over the vertices of both, since a closest
+    pair has a vertex at one end.
 
     The nearest edge and the winding number are found without autograd over all (P, M)
     pairs; δ is then recomputed, differentiably, for the nearest edge only (the gradient of
@@ -102,8 +105,9 @@ def signed_ring_distance(
     edges = ends - nodes  # (B or 1, M, 2)
     edge_mask = None if mask is None else mask[:, None]
     d2_min, nearest, inside = _nearest_edge_and_inside(
-        points.detach(), nodes[:, None].detach(), edges[:, None].detach(), edge_mask
-    )
+        points.detach(), nodes[:, None].detach(), edges[:, None].detach(), edge_mask,
+        ends[:, None, :, 1].detach(),
+    )  # fmt: skip
     pick = nearest[..., None].expand(*nearest.shape, 2)
     a = torch.gather(nodes.expand(b, -1, -1), 1, pick)  # (B, P, 2)
     e = torch.gather(edges.expand(b, -1, -1), 1, pick)
@@ -116,12 +120,17 @@ def signed_ring_distance(
 
 @torch.no_grad()
 def _nearest_edge_and_inside(
-    points: torch.Tensor, a: torch.Tensor, e: torch.Tensor, mask: torch.Tensor | None
+    points: torch.Tensor,
+    a: torch.Tensor,
+    e: torch.Tensor,
+    mask: torch.Tensor | None,
+    end_y: torch.Tensor,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """For points (B, P, 2) and edges a_m + t e_m given by a and e (B or 1, P or 1, M, 2),
-    masked edges (mask broadcastable to (B, P, M)) left out: the smallest squared distance
-    min_m δ²_pm (B, P), its edge m (B, P), and whether the winding number around p is
-    non-zero (B, P) (see :func:`signed_ring_distance`).
+    ending at height end_y = b_y (B or 1, P or 1, M), masked edges (mask broadcastable to
+    (B, P, M)) left out: the smallest squared distance min_m δ²_pm (B, P), its edge m (B, P),
+    and whether the winding number around p is non-zero (B, P) (see
+    :func:`signed_ring_distance`).
 
     x and y are separate contiguous (B, P, M) tensors (no reductions over a trailing 2)."""
     ax, ay = a[..., 0].contiguous(), a[..., 1].contiguous()
@@ -135,8 +144,9 @@ def _nearest_edge_and_inside(
         d2 = d2.masked_fill_(~mask, PAD_DIST2)
     d2_min, nearest = d2.min(-1)
     left = (ex * wy).sub_(ey * wx)  # e × (p − a) > 0: p left of the edge
-    up = (wy >= 0) & (wy < ey)  # a_y ≤ p_y < b_y
-    down = (wy < 0) & (wy >= ey)  # b_y ≤ p_y < a_y
+    py = points[..., 1, None]
+    up = (ay <= py) & (py < end_y)  # a_y ≤ p_y < b_y (coordinates, not their differences)
+    down = (end_y <= py) & (py < ay)  # b_y ≤ p_y < a_y
     winding = (up & (left > 0)).int() - (down & (left < 0)).int()
     if mask is not None:
         winding = winding.masked_fill(~mask, 0)
