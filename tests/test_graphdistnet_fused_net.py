@@ -1,14 +1,16 @@
 """The whole-network pass of GraphDistNet (models/graphdistnet/fused_net.py) against the torch
 reference path (``fused=False``: autograd through :meth:`GraphDistNet.lean`). Every shipped
-weights file the pass serves (soft-kNN: one-way d, e; two-way b and ur5e, the planar fetch's; a
-and c are two-way with node distances, which the pass leaves to the ring-message kernels) and
+weights file the pass serves (soft-kNN: two-way b; one-way with node distances and the soft
+minimum d, e and ur5e, the planar fetch's, since 2026-12-04; a and c are two-way with node
+distances, which the pass leaves to the ring-message kernels) and
 random one-way networks with node distances (each option), random and near-contact
 configurations, more than one tile. Float64: d̂ and ∂d̂/∂q agree to 1e-9 relative (the same
 function up to summation order). Float32 against a float64 truth: the yardstick is the
 reference's own float32 error. d̂ agrees with float64 to ~1e-6 m in both (asserted: 2e-6 ·
 scale); single gradients do not reach 1e-6 relative in either path, because float32 rounding
 flips pre-activations within ~1e-7 of a LeakyReLU kink onto the other slope (over the 40
-configurations here, on 2026-12-02 with two-way networks in the pass, the 90th-percentile
+configurations here, on 2026-12-02 with the networks shipped then (d, e one-way without node
+distances, b and ur5e two-way), the 90th-percentile
 relative gradient error was, whole pass / reference, 1.9e-6 / 3.3e-6 (b), 3.7e-6 / 6.1e-6 (d),
 3.6e-6 / 7.1e-6 (e), 1.2e-5 / 1.1e-5 (ur5e); the worst 1.6e-5 / 1.1e-4, 1.7e-3 / 1.7e-3, 3.6e-5
 / 4.7e-5, 6.7e-5 / 1.1e-4; the largest d̂ error 1.3e-6 m or less in both). Asserted: the whole
