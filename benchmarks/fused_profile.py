@@ -19,6 +19,7 @@ from gdnplan.assets import default_weights
 from gdnplan.models.graphdistnet import fused, fused_net
 from gdnplan.models.graphdistnet import fused_net_backward as bw
 from gdnplan.models.graphdistnet import fused_net_kernels as fw
+from gdnplan.models.graphdistnet.fused_net_distances import points_backward, tile_distances
 
 
 def profile(packed, x, seconds) -> None:
@@ -29,22 +30,8 @@ def profile(packed, x, seconds) -> None:
     layers, h = net.att.shape
     tile = max(1, fused_net.TILE_ROWS // (3 * n))
     dt = x.dtype
-    hidden, width = net.wht.shape[1], net.h0t.shape[0]
-    st = fw.State(
-        np.empty((tile, n, 2), dt),
-        np.empty((tile, n, cand), np.int64),
-        np.empty((tile, n, cand), dt),
-        np.empty((tile, n, cand), dt),
-        np.empty((layers, tile, n, cand), dt),
-        np.empty((layers, tile * n if n > n_r else 0, h), dt),
-        np.empty((layers, tile * n, h), dt),
-        np.empty((layers, hidden + 1, 3 * tile * n, h), np.bool_),
-        np.empty((layers, tile, n), dt),
-        np.empty((layers, tile, n), dt),
-        np.empty((layers, tile, width), np.bool_),
-        np.empty((tile, width), np.int64),
-        np.empty((net.hw.shape[0] + 1, tile, net.wlast.shape[0]), np.bool_),
-    )
+    width = net.h0t.shape[0]
+    st = fw.new_state(x, net, cand, tile)
     two_way = n > n_r
     g_out = np.zeros((bsz, n_r, 2), dt)
 
@@ -58,15 +45,19 @@ def profile(packed, x, seconds) -> None:
         xt = x[b0 : b0 + tile]
         t_n = xt.shape[0]
         timed("candidates", fw._candidates, xt, net, st)
+        if net.din.shape[1]:
+            timed("node/probe distances", tile_distances, xt, net, st.s, st.ds)
         pooled = np.empty((t_n, width), dt)
         for k in range(layers):
             timed("soft weights", fw._soft_weights, net, st, k, t_n, two_way)
             uv, cc = timed("node terms", fw._node_terms, net, st, k, t_n, two_way)
             timed("edge MLP", fw._edge_mlp, net, st, k, t_n, uv, cc)
             timed("readout", fw._readout, net, st, k, t_n, n_r, pooled)
+        timed("head", fw._head, net, st, pooled, np.empty(t_n, dt))
         rows = t_n * n
         g = g_out[b0 : b0 + tile]
-        dy = timed("head (bw)", bw._head_backward, net, st, t_n)
+        gs = np.zeros((t_n, st.s.shape[1]), dt)
+        dy = timed("head (bw)", bw._head_backward, net, st, t_n, gs)
         dh = np.zeros((rows, h), dt)
         dlphi = np.zeros((t_n, n, cand), dt)
         dnear = np.zeros((t_n, n, cand), dt)
@@ -74,6 +65,10 @@ def profile(packed, x, seconds) -> None:
         for k in range(layers - 1, -1, -1):
             timed("readout (bw)", bw._readout_backward, net, st, k, t_n, n_r, dy, dh)
             duv, dc = timed("edge MLP (bw)", bw._edge_backward, net, st, k, t_n, dh)
+            if net.din.shape[1]:
+                t0 = time.thread_time()
+                gs[:, :n] += (dc @ net.din[k]).reshape(t_n, n)
+                seconds["node distances (bw, numpy)"] += time.thread_time() - t0
             dscore[:] = 0
             args = (net, st, k, t_n, two_way, duv, dc, dlphi, dnear, dscore)
             timed("cross (bw)", bw._cross_backward, *args)
@@ -82,6 +77,8 @@ def profile(packed, x, seconds) -> None:
                 dh = np.dot(duv, net.aht[k])
                 seconds["dz (bw, numpy)"] += time.thread_time() - t0
         timed("candidates (bw)", bw._candidates_backward, net, st, t_n, n_r, dlphi, dnear, g)
+        if gs.shape[1]:
+            timed("points (bw)", points_backward, net, gs, st.ds[:t_n], g)
 
 
 def main() -> None:

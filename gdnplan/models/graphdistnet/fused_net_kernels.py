@@ -242,6 +242,13 @@ if AVAILABLE:
             uv, cc = _node_terms(net, st, k, t_n, two_way)
             _edge_mlp(net, st, k, t_n, uv, cc)
             _readout(net, st, k, t_n, n_r, pooled)
+        _head(net, st, pooled, d_out)
+
+    @_jit
+    def _head(net, st, pooled, d_out):
+        """d_out (T,) ← d̂ of the tile's pooled readouts (T, P) (st.hmask ← the signs; with
+        ``min_readout`` st.m, st.sw ← the soft minimum and its weights, st.y ← the MLP)."""
+        t_n = pooled.shape[0]
         a = mm(pooled, net.h0t)  # the head (one-way: its obstacle half is in hb0)
         if net.hm.shape[0]:  # min_readout: the soft minimum is the head's last input
             for t in range(t_n):
@@ -263,16 +270,16 @@ if AVAILABLE:
                 d_out[t] = out * net.scale
 
     @_jit
-    def network(x, net, cand, d_out, g_out, tile):
-        """d_out (B,) ← d̂ of normalised robot nodes x (B, N_r, 2); g_out (B, N_r, 2) ← ∂d̂/∂x
-        (skipped when g_out has no rows), ``tile`` configurations at a time."""
-        bsz, n_r, _ = x.shape
+    def new_state(x, net, cand, tile):
+        """An empty :class:`State` for tiles of up to ``tile`` configurations of robot nodes
+        like x (B, N_r, 2) (their count and dtype)."""
+        n_r = x.shape[1]
         n = net.ring.shape[1]
         layers, h = net.att.shape
         dt = x.dtype
         hidden, width = net.wht.shape[1], net.h0t.shape[0]
         points = n_r * net.probe if net.din.shape[1] else 0
-        st = State(
+        return State(
             np.empty((tile, n, 2), dt),
             np.empty((tile, n, cand), np.int64),
             np.empty((tile, n, cand), dt),
@@ -292,8 +299,14 @@ if AVAILABLE:
             np.empty(tile, dt),
             np.empty(tile, dt),
         )
-        for b0 in range(0, bsz, tile):
-            b1 = min(b0 + tile, bsz)
+
+    @_jit
+    def network(x, net, cand, d_out, g_out, tile):
+        """d_out (B,) ← d̂ of normalised robot nodes x (B, N_r, 2); g_out (B, N_r, 2) ← ∂d̂/∂x
+        (skipped when g_out has no rows), ``tile`` configurations at a time."""
+        st = new_state(x, net, cand, tile)
+        for b0 in range(0, x.shape[0], tile):
+            b1 = min(b0 + tile, x.shape[0])
             _forward_tile(x[b0:b1], net, st, d_out[b0:b1])
             if g_out.shape[0] > 0:
                 _backward_tile(x[b0:b1], net, st, g_out[b0:b1])
