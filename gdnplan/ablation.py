@@ -357,15 +357,15 @@ def notes(s: Settings, n_test: str) -> str:
     return f"""
 Notes: each step changes one field of the step above (`gdnplan.ablation.STEPS`). Every step
 is trained from scratch on the same data (`data/<env>/train`, the shipped weights' share of
-it) for the same {s.budget:g} s of training (the epochs' CPU time on one torch thread: the
-same work whatever else ran on the shared machine; early stopping after 40 epochs without
-a better validation MAE), with the paper's loss (squared distance error only) and the same
-seeds; ± is the standard error over the seeds. MAE, AUC, ACD: the {n_test} samples of
-`data/<env>/test` (seed 1). d̂+∇: one batch of {s.timing_batch} configurations of one scene,
-CPU time of the fastest of 5, one thread (the default inference path: the compiled pass
-where it serves the network). Sweep max: the
-largest change of d̂ between 0.003 rad steps along {s.sweep_steps}-step sweeps of every joint
-from {s.sweeps} configuration(s), the largest over the seeds. Table II: Ipopt on the
+it) for the same {s.budget:g} s of training (the epochs' CPU time on one torch thread; a CPU
+second does less work when other jobs share the machine: compare the epochs, last column;
+early stopping after 40 epochs without a better validation MAE), with the paper's loss
+(squared distance error only) and the same seeds; ± is the standard error over the seeds.
+MAE, AUC, ACD: the {n_test} samples of `data/<env>/test` (seed 1). d̂+∇: one batch of
+{s.timing_batch} configurations of one scene, CPU time of the fastest of 5, one thread (the
+default inference path: the compiled pass where it serves the network). Sweep max: the
+largest change of d̂ between 0.003 rad steps along {s.sweep_steps}-step sweeps of every
+joint from {s.sweeps} configuration(s), the largest over the seeds. Table II: Ipopt on the
 environment's own reaching problems (b and d only), certified successes over all seeds, the
 median wall time and the median CPU time of the planning process (the work: wall times of
 rows scored while other jobs ran are longer; rows scored before it was recorded show "–").
