@@ -196,7 +196,7 @@ def score(weights: Path, env: str, s: Settings) -> dict:
         "mae": test["mae_m"], "auc": test["auc"], "acd": test["acd"], "n_test": test["n"],
         "seconds": card["training"]["seconds"], "epochs": card["training"]["epochs"],
         "sweep_max": sweep_max(model, scene, s.sweeps, s.sweep_steps),
-    } | timing(weights, env, s)  # fmt: skip
+    } | timing(model, env, s)  # fmt: skip
     if s.table2 and env in TABLE2_SETTINGS:
         out["t2_success"], out["t2_median"], out["t2_cpu"] = table2_ipopt(model, env, s.table2)
         out["t2_n"], out["t2_git"] = s.table2, loaded_code()  # the planner that solved them
@@ -210,14 +210,12 @@ def loaded_code() -> str:
     return git_sha()
 
 
-def timing(weights: Path, env: str, s: Settings) -> dict:
-    """The d̂+∇ column of one trained step (:func:`grad_time`) and the code that measured it
-    (``time_git``: the inference kernels change under kept steps; ``--retime`` measures
-    again)."""
-    from .models import load_model
+def timing(model, env: str, s: Settings) -> dict:
+    """The d̂+∇ column of one trained step's loaded ``model`` (:func:`grad_time`) and the code
+    that measured it (``time_git``: the inference kernels change under kept steps;
+    ``--retime`` measures again)."""
     from .scene import make_scene
 
-    model = load_model(weights, threads=1)
     return {"grad_time": grad_time(model, make_scene(env, seed=11), s.timing_batch),
             "time_git": loaded_code()}  # fmt: skip
 
@@ -280,7 +278,10 @@ def run(
                 if not cached.exists():
                     cached.write_text(json.dumps(score(weights, env, s), indent=1) + "\n")
                 elif retime:
-                    scores = json.loads(cached.read_text()) | timing(weights, env, s)
+                    from .models import load_model
+
+                    model = load_model(weights, threads=1)
+                    scores = json.loads(cached.read_text()) | timing(model, env, s)
                     cached.write_text(json.dumps(scores, indent=1) + "\n")
                 log(f"ablation {env} {STEPS[step][0]} seed {seed}: {cached.read_text()}")
     return {env: [_kept_scores(runs, env, step, seeds) for step in range(len(STEPS))]

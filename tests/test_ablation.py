@@ -169,7 +169,10 @@ def test_retime_measures_kept_steps_again_and_keeps_the_rest(tmp_path, monkeypat
     weights.write_bytes(b"")
     cached = weights.with_suffix(".scores.json")
     cached.write_text(json.dumps({"mae": 0.01, "grad_time": 9.0}))
-    monkeypatch.setattr(ablation, "timing", lambda w, env, s: {"grad_time": 1e-4, "time_git": "x"})
+    import gdnplan.models
+
+    monkeypatch.setattr(gdnplan.models, "load_model", lambda path, threads: path)
+    monkeypatch.setattr(ablation, "timing", lambda m, env, s: {"grad_time": 1e-4, "time_git": "x"})
     root = tmp_path / "data"
     ablation.run(("b",), 1, ablation.Settings(), root, runs, log=lambda m: None, train_for=0)
     assert json.loads(cached.read_text()) == {"mae": 0.01, "grad_time": 9.0}
