@@ -7,7 +7,7 @@ gradient :func:`.fused_net_backward._backward_tile` runs the reverse pass at onc
 network's arrays travel as one :class:`Net`. Shapes: T configurations per tile, n union rows
 per configuration (the N_r robot nodes, then for two-way networks the N_o obstacle nodes),
 C candidates, K layers, H features, P = H (one-way) or 2 H (two-way) pooled features, L
-hidden layers of the edge MLP, R readout width, P distance points per configuration (0
+hidden layers of the edge MLP, R readout width, Q distance points per configuration (0
 without node distances; :mod:`.fused_net_distances`).
 """
 
@@ -44,7 +44,7 @@ candidates (partner rows, d², log φ), w (K, T, n, C) soft weights, v (K, T n, 
 partner terms (one-way: no rows), h (K, T n, H) features, mask (K, L + 1, 3 T n, H) signs of
 the edge pre-activations, logit / alpha (K, T, n) readout scores and weights, ypos (K, T, P)
 signs of the readouts, src (T, P) the layer of each pooled maximum, hmask (Lr + 1, T, R)
-signs of the head's pre-activations; s / ds / sw (T, P), (T, P, 2), (T, P) the points'
+signs of the head's pre-activations; s / ds / sw (T, Q), (T, Q, 2), (T, Q) the points'
 distances, gradients and soft-minimum weights, m / y (T,) the soft minimum and the head's
 output."""
 
