@@ -2,9 +2,10 @@
 
 :data:`STEPS` starts at the paper's network (§IV, :meth:`GraphDistNetConfig.faithful`) and
 each step changes one architecture field of the step before; every step is trained with the
-same data, time budget (CPU seconds of the training process: the same work however busy
-the shared machine is), seeds and loss (the paper's: the squared distance error, no gradient
-or contact terms) and scored on the same held-out samples:
+same data, number of Adam steps (:data:`EPOCHS` epochs of the environment's training rows,
+batch 256: a budget of optimiser steps, not seconds, because a CPU second on the shared machine
+does less work when other jobs share its caches), seeds and loss (the paper's: the squared
+distance error, no gradient or contact terms) and scored on the same held-out samples:
 
 * MAE (m), AUC and ACD on the test split (the card's, :func:`gdnplan.train.report.evaluate`),
   the mean over training seeds ± its standard error s / √S (S ≥ 2 seeds);
@@ -19,8 +20,9 @@ or contact terms) and scored on the same held-out samples:
 budget of the shipped (best) weights of the environment, :data:`BEST` (their cards).
 Every trained step is kept (``results/ablation/<env>/<step>-s<seed>.safetensors`` + card, its
 scores in ``….scores.json``; the repository keeps them, so the ≈ 14 h run accumulates over
-sessions) and skipped when present; an interrupted training resumes from its
-checkpoint.
+sessions) and skipped when it has its epochs; an interrupted training, or one kept with fewer
+epochs, resumes from its checkpoint (the schedule depends on the epoch count only, so a resumed
+run equals one trained straight through); one kept with more epochs is trained again.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from __future__ import annotations
 import functools
 import json
 import math
+import shutil
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -42,6 +45,7 @@ from .train import FitConfig, GraphDistNetLoss, TrainConfig, git_sha
 __all__ = [
     "BEST",
     "ENVS",
+    "EPOCHS",
     "RUNS_DIR",
     "STEPS",
     "Best",
@@ -68,6 +72,10 @@ STEPS: tuple[tuple[str, str, dict], ...] = (
     ("band", "d̂ = the soft minimum beyond ≈ 2 cm of contact", {"correction_band": 0.01}),
 )
 ENVS = ("b", "d", "e")
+# Epochs per step and seed: about what the 4 × 32 steps trained in 1 200 CPU s on a quiet
+# machine (docs/decisions.md, 2026-12-04, fifth session).
+EPOCHS = {"a": 50, "b": 50, "c": 50, "d": 10, "e": 10}
+PATIENCE = 40  # epochs without a better validation MAE before a step stops early
 TABLE2_SETTINGS = ("b", "d")  # environments with a Table II setting of their own
 
 
@@ -125,8 +133,7 @@ def faithful_config(
 class Settings:
     """Sizes of one ablation run (:meth:`fast` for CI)."""
 
-    budget: float = 1200.0  # training seconds per step and seed
-    epochs: int = 1000
+    epochs: int | None = None  # epochs per step and seed (None: EPOCHS of the environment)
     batch: int = 256
     sweeps: int = 3  # random start configurations of the joint sweeps
     sweep_steps: int = 200
@@ -135,8 +142,12 @@ class Settings:
 
     @classmethod
     def fast(cls) -> Settings:
-        return cls(budget=30.0, epochs=1, batch=16, sweeps=1, sweep_steps=20, timing_batch=16,
+        return cls(epochs=1, batch=16, sweeps=1, sweep_steps=20, timing_batch=16,
                    table2=0)  # fmt: skip
+
+    def epochs_of(self, env: str) -> int:
+        """The epochs each step of ``env`` trains for."""
+        return self.epochs or EPOCHS[env]
 
 
 def sweep_max(model, scene, sweeps: int = 3, steps: int = 200) -> float:
@@ -225,20 +236,45 @@ def _weights_path(runs: Path, env: str, step: int, seed: int) -> Path:
 
 
 def train_step(env: str, step: int, seed: int, s: Settings, data_root: Path, runs: Path) -> Path:
-    """Train ``STEPS[step]`` with ``seed`` (skipped when its weights exist); their path."""
+    """Train ``STEPS[step]`` with ``seed`` to ``s.epochs_of(env)`` epochs (skipped when kept
+    with them; module docstring); the weights' path."""
     from .train import train
 
     out = _weights_path(runs, env, step, seed)
-    name = out.stem
-    if out.exists():
+    name, epochs = out.stem, s.epochs_of(env)
+    run_dir = runs / env / name
+    if _trained(out, run_dir, epochs):
         return out
+    if _checkpoint_epochs(run_dir) > epochs:
+        shutil.rmtree(run_dir)  # trained past the budget: start over
+    for kept in (out, out.with_suffix(".json"), out.with_suffix(".scores.json")):
+        kept.unlink(missing_ok=True)  # they describe another number of epochs
     best = BEST[env]
-    fit = FitConfig(batch=s.batch, epochs=s.epochs, patience=40, time_budget=s.budget, seed=seed,
+    fit = FitConfig(batch=s.batch, epochs=epochs, patience=PATIENCE, seed=seed,
                     budget_clock="cpu")  # fmt: skip
     config = TrainConfig(step_config(step), GraphDistNetLoss(), fit, best.n_train,
                          _extra(env, data_root))  # fmt: skip
-    train(env, config, name, data_root=data_root, out=out, run_dir=runs / env / name)
+    train(env, config, name, data_root=data_root, out=out, run_dir=run_dir)
     return out
+
+
+def _trained(weights: Path, run_dir: Path, epochs: int) -> bool:
+    """Whether the kept ``weights`` trained ``epochs`` epochs, or stopped early before them."""
+    card = weights.with_suffix(".json")
+    if not (weights.exists() and card.exists()):
+        return False
+    done = json.loads(card.read_text())["training"]["epochs"]
+    if done == epochs:
+        return True
+    state = run_dir / "checkpoint.json"
+    stopped = state.exists() and json.loads(state.read_text())["stale"] >= PATIENCE
+    return done < epochs and stopped
+
+
+def _checkpoint_epochs(run_dir: Path) -> int:
+    """Epochs of the checkpoint in ``run_dir`` (0: none)."""
+    state = run_dir / "checkpoint.json"
+    return json.loads(state.read_text())["epoch"] if state.exists() else 0
 
 
 RUNS_DIR = Path("results/ablation")  # trained steps, kept in the repository between sessions
@@ -271,9 +307,11 @@ def run(
         for env in envs:
             for step in range(len(STEPS)):
                 weights = _weights_path(runs, env, step, seed)
-                if not weights.exists() and time.monotonic() >= deadline:
+                due = not _trained(weights, weights.with_suffix(""), s.epochs_of(env))
+                if due and time.monotonic() < deadline:
+                    train_step(env, step, seed, s, data_root, runs)
+                if not weights.exists():
                     continue
-                weights = train_step(env, step, seed, s, data_root, runs)
                 cached = weights.with_suffix(".scores.json")
                 if not cached.exists():
                     cached.write_text(json.dumps(score(weights, env, s), indent=1) + "\n")
@@ -329,12 +367,25 @@ def markdown(results: dict[str, list[list[dict]]], s: Settings) -> str:
             )
     n_test = sorted({r["n_test"] for steps in results.values() for runs in steps for r in runs})
     return (
-        "\n".join(lines) + "\n" + notes(s, "/".join(map(str, n_test)))
+        "\n".join(lines) + "\n" + notes(s, "/".join(map(str, n_test)), tuple(results))
+        + _short(results, s)
         + _versions(results, "t2_git", "Table II rows were solved by", "planner",
                     "delete the `.scores.json` files to re-score")
         + _versions(results, "time_git", "d̂+∇ was measured by", "code",
                     "`--retime` measures every kept step again")
     )  # fmt: skip
+
+
+def _short(results: dict[str, list[list[dict]]], s: Settings) -> str:
+    """A note naming the rows with a seed trained for other than the environment's epochs
+    (kept from an earlier budget, until a run trains them to it)."""
+    rows = [f"{env} {name}" for env, steps in results.items()
+            for (name, _, _), runs in zip(STEPS, steps, strict=True)
+            if any(r["epochs"] != s.epochs_of(env) for r in runs)]  # fmt: skip
+    if not rows:
+        return ""
+    return (f"Not yet at the epochs above (kept from an earlier budget; the last column says "
+            f"how many): {', '.join(rows)}.\n")  # fmt: skip
 
 
 def _versions(
@@ -354,14 +405,15 @@ def _versions(
     )
 
 
-def notes(s: Settings, n_test: str) -> str:
+def notes(s: Settings, n_test: str, envs: tuple[str, ...]) -> str:
+    epochs = ", ".join(f"{env} {s.epochs_of(env)}" for env in envs)
     return f"""
 Notes: each step changes one field of the step above (`gdnplan.ablation.STEPS`). Every step
 is trained from scratch on the same data (`data/<env>/train`, the shipped weights' share of
-it) for the same {s.budget:g} s of training (the epochs' CPU time on one torch thread; a CPU
-second does less work when other jobs share the machine: compare the epochs, last column;
-early stopping after 40 epochs without a better validation MAE), with the paper's loss
-(squared distance error only) and the same seeds; ± is the standard error over the seeds.
+it) for the same number of Adam steps: {epochs} epochs (batch {s.batch}; early stopping
+after {PATIENCE} epochs without a better validation MAE), with the paper's loss (squared
+distance error only) and the same seeds; ± is the standard error over the seeds. Train s:
+the CPU seconds those epochs took on one torch thread (the cost of a step's epochs).
 MAE, AUC, ACD: the {n_test} samples of `data/<env>/test` (seed 1). d̂+∇: one batch of
 {s.timing_batch} configurations of one scene, CPU time of the fastest of 5, one thread (the
 default inference path: the compiled pass where it serves the network). Sweep max: the

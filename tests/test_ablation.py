@@ -199,3 +199,81 @@ def test_ablation_figure_plots_means_gaps_and_refuses_a_wrong_shape():
     assert np.isnan(line.get_ydata()[1]) and len(fig.axes) == 4
     with pytest.raises(InputError, match="one list of seed scores per step"):
         ablation_figure(["faithful"], results)
+
+
+def _keep(runs, name: str, epochs: int, stale: int | None = None):
+    """A kept step ``b/<name>`` trained ``epochs`` epochs (weights, card, scores, checkpoint)."""
+    weights = runs / "b" / f"{name}.safetensors"
+    (runs / "b" / name).mkdir(parents=True)
+    weights.write_bytes(b"")
+    weights.with_suffix(".json").write_text(json.dumps({"training": {"epochs": epochs}}))
+    weights.with_suffix(".scores.json").write_text(json.dumps({"epochs": epochs}))
+    if stale is not None:
+        state = {"epoch": epochs, "stale": stale}
+        (runs / "b" / name / "checkpoint.json").write_text(json.dumps(state))
+    return weights
+
+
+@pytest.mark.parametrize(
+    ("epochs", "stale", "trained", "run_dir_kept"),
+    [
+        (3, 0, True, True),  # short of the budget, checkpoint: resumed from it
+        (3, None, True, True),  # short, no checkpoint (another machine): trained from scratch
+        (3, ablation.PATIENCE, False, True),  # stopped early: done
+        (5, 0, False, True),  # at the budget: kept
+        (9, 0, True, False),  # past the budget: trained again from scratch
+    ],
+)
+def test_a_kept_step_is_trained_to_the_epoch_budget(
+    tmp_path, monkeypatch, epochs, stale, trained, run_dir_kept
+):
+    runs = tmp_path / "runs"
+    weights = _keep(runs, "faithful-s0", epochs, stale)
+    calls = []
+
+    def fake_train(env, config, name, data_root, out, run_dir):
+        calls.append((config.fit.epochs, config.fit.time_budget, run_dir.exists(),
+                      out.with_suffix(".scores.json").exists()))  # fmt: skip
+
+    monkeypatch.setattr(training, "train", fake_train)
+    ablation.train_step("b", 0, 0, ablation.Settings(epochs=5), tmp_path, runs)
+    if not trained:
+        assert calls == [] and weights.with_suffix(".scores.json").exists()
+        return
+    # the budget is epochs, not seconds; the old scores are gone before training
+    assert calls == [(5, None, run_dir_kept, False)]
+
+
+def test_epochs_default_per_environment_and_the_notes_say_which_rows_are_short():
+    s = ablation.Settings()
+    assert s.epochs_of("d") == ablation.EPOCHS["d"]
+    assert ablation.Settings(epochs=3).epochs_of("d") == 3
+    row = {"mae": 0.01, "auc": 0.99, "acd": 0.2, "n_test": 10, "seconds": 1.0,
+           "grad_time": 1e-4, "sweep_max": 0.01}  # fmt: skip
+    empty = [[] for _ in ablation.STEPS[2:]]
+    at = row | {"epochs": s.epochs_of("b")}
+    text = ablation.markdown({"b": [[at], [at], *empty]}, s)
+    assert f"b {s.epochs_of('b')} epochs" in text and "Not yet at the epochs" not in text
+    short = ablation.markdown({"b": [[at], [at, row | {"epochs": 2}], *empty]}, s)
+    assert "Not yet at the epochs above" in short and "b soft-partners." in short
+
+
+def test_a_resumed_step_equals_one_trained_straight_through(tmp_path):
+    """The epoch budget's premise: training 1 epoch, then resuming to 2, gives the weights of
+    2 epochs in one go (the schedule depends on the epoch count only)."""
+    from safetensors.numpy import load_file
+
+    root = tmp_path / "data"
+    data.generate("b", 24, 0, data.split_dir("b", "train", root), workers=1)
+    data.generate("b", 12, 1, data.split_dir("b", "test", root), workers=1)
+    fast = ablation.Settings.fast()
+    two = ablation.Settings(epochs=2, batch=fast.batch)
+    straight = ablation.train_step("b", 1, 0, two, root, tmp_path / "straight")
+    ablation.train_step("b", 1, 0, fast, root, tmp_path / "resumed")
+    state = tmp_path / "resumed" / "b" / "soft-partners-s0" / "checkpoint.json"
+    first = json.loads(state.read_text())["log"]
+    resumed = ablation.train_step("b", 1, 0, two, root, tmp_path / "resumed")
+    assert json.loads(state.read_text())["log"][:1] == first  # epoch 0 not trained again
+    assert json.loads(resumed.with_suffix(".json").read_text())["training"]["epochs"] == 2
+    a, b = load_file(straight), load_file(resumed)
+    assert a.keys() == b.keys() and all((a[k] == b[k]).all() for k in a)

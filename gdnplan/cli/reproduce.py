@@ -194,7 +194,9 @@ def ablation_command(
     fast: bool = typer.Option(False, "--fast", help="Tiny data, one epoch (CI; not a result)."),
     envs: str = typer.Option("b,d,e", help="Environments (comma-separated)."),
     seeds: int = typer.Option(2, min=1, help="Training seeds per step."),
-    budget: float = typer.Option(1200.0, help="Training seconds per step and seed (> 0)."),
+    epochs: int = typer.Option(
+        None, min=1, help="Epochs per step and seed (default: gdnplan.ablation.EPOCHS)."
+    ),
     data: Path = typer.Option(None, help="Data root (default data/; --fast: a temporary one)."),
     runs: Path = typer.Option(
         Path("results/ablation"), help="Trained steps (kept in the repository, skipped)."
@@ -211,7 +213,7 @@ def ablation_command(
     ),
 ) -> None:
     """Faithful → soft partners → one-way → node distances → soft-minimum readout → probe
-    points → band readout, one change a step, same data, budget and seeds (resumable)."""
+    points → band readout, one change a step, same data, epochs and seeds (resumable)."""
     import datetime
     import tempfile
 
@@ -224,12 +226,10 @@ def ablation_command(
     chosen = tuple(e.strip() for e in envs.split(",") if e.strip())
     if not chosen or any(e not in ablation.BEST for e in chosen):
         raise InputError(f"--envs: expected some of {sorted(ablation.BEST)}, got {envs!r}")
-    if not budget > 0:
-        raise InputError(f"--budget: expected a positive number of seconds, got {budget}")
     if train_for is not None and not 0 <= train_for < float("inf"):
         raise InputError(f"--train-for: expected seconds ≥ 0, got {train_for}")
     set_threads(1, torch_global=True)
-    s = ablation.Settings.fast() if fast else ablation.Settings(budget=budget)
+    s = ablation.Settings.fast() if fast else ablation.Settings(epochs=epochs)
     with tempfile.TemporaryDirectory() as tmp:
         root = data or (Path(tmp) / "data" if fast else DATA_DIR)
         if fast:
@@ -246,7 +246,7 @@ def ablation_command(
         )  # fmt: skip
     command = (
         f"gdnplan reproduce ablation{' --fast' if fast else ''} --envs {','.join(chosen)} "
-        f"--seeds {seeds}" + ("" if fast else f" --budget {budget:g}")
+        f"--seeds {seeds}" + (f" --epochs {epochs}" if epochs and not fast else "")
     )
     text = "\n".join([
         "# Ablation: the paper's GraphDistNet to gdnplan's, one change a step"
