@@ -33,7 +33,10 @@ def star(rng: np.random.Generator) -> np.ndarray:
     ring = centre + radii[:, None] * np.stack([np.cos(angles), np.sin(angles)], 1)
     level = rng.uniform(size=n) < 0.3
     ring[1:, 1] = np.where(level[1:], ring[:-1, 1], ring[1:, 1])
-    return ring if Polygon(ring).is_valid else centre + 0.3 * np.array([[0, -1], [1, 1], [-1, 1]])
+    if not Polygon(ring).is_valid:
+        return centre + 0.3 * np.array([[0, -1], [1, 1], [-1, 1]])
+    # levelling can turn a triangle clockwise; scenes hold CCW rings (geometry.as_polygon)
+    return ring if Polygon(ring).exterior.is_ccw else ring[::-1].copy()
 
 
 def scene(seed: int, rings: int, dtype) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

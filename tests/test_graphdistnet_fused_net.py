@@ -22,6 +22,8 @@ import os
 import numpy as np
 import pytest
 import torch
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import gdnplan as gp
 from gdnplan.models.graphdistnet import (
@@ -188,3 +190,34 @@ def test_whole_pass_gradient_with_node_distances_matches_finite_differences():
         step[j] = eps
         fd = (whole.distance(scene, q + step) - whole.distance(scene, q - step)) / (2 * eps)
         np.testing.assert_allclose(g[:, j], fd, rtol=1e-5, atol=1e-6)
+
+
+@needs_numba
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    partners=st.integers(1, 12),
+    cand=st.integers(1, 6),
+    ties=st.booleans(),
+    single=st.booleans(),
+)
+def test_point_parallel_candidates_equal_the_insertion_search(seed, partners, cand, ties, single):
+    """The tile's candidates (vectorised over its points) are :func:`_nearest`'s, point by
+    point: the same rows in the same order (ties to the lower row), d² and log φ, also with
+    fewer partners than candidates (padded) and with repeated partners (exact ties)."""
+    from gdnplan.models.graphdistnet.fused_net_kernels import _nearest, _point_candidates
+
+    dtype = np.float32 if single else np.float64
+    rng = np.random.default_rng(seed)
+    xo = rng.uniform(-1, 1, (partners, 2)).astype(dtype)
+    if ties:
+        xo[rng.integers(0, partners, partners)] = xo[0]  # repeated rows: equal d²
+    x = rng.uniform(-1.2, 1.2, (3, 5, 2)).astype(dtype)
+    x[0, 0] = xo[-1]  # a point on a partner: d² = 0
+    got = [np.empty((3, 5, cand), t) for t in (np.int64, dtype, dtype)]
+    _point_candidates(x, xo, 7, *got)
+    for t, i in np.ndindex(3, 5):
+        want = [np.empty(cand, a.dtype) for a in got]
+        _nearest(x[t, i, 0], x[t, i, 1], xo, 7, *want)
+        for a, b in zip(got, want, strict=True):
+            np.testing.assert_array_equal(a[t, i], b)
