@@ -31,7 +31,8 @@ def as_polygon(vertices, name: str = "polygon") -> np.ndarray:
 
     Raises InputError naming ``name`` for a wrong shape, NaN or infinite coordinates, fewer
     than 3 or more than ``MAX_VERTICES`` vertices, repeated vertices (edges shorter than
-    ``MIN_THICKNESS``), zero area or self-intersection. Booleans and strings are no numbers.
+    ``MIN_THICKNESS``), zero area (collinear vertices, checked first: a flat polygon
+    is also invalid to shapely) or self-intersection. Booleans and strings are no numbers.
     """
     poly = _float_array(vertices, name)
     if poly.ndim != 2 or poly.shape[1] != 2:
@@ -55,12 +56,23 @@ def as_polygon(vertices, name: str = "polygon") -> np.ndarray:
             f"{name}: vertices {k} and {(k + 1) % len(poly)} are repeated or closer than "
             f"{MIN_THICKNESS} m; remove one"
         )
+    if _collinear(poly):
+        raise InputError(f"{name}: the polygon has zero area (collinear vertices)")
     if not Polygon(poly).is_valid:
         raise InputError(f"{name}: the polygon intersects itself; list its vertices in order")
     area = signed_area(poly)
     if abs(area) < 1e-12:
         raise InputError(f"{name}: the polygon has zero area")
     return poly if area > 0 else poly[::-1].copy()
+
+
+def _collinear(poly: np.ndarray, rel: float = 1e-12) -> bool:
+    """True when every vertex lies within rel · max(1 m, extent) of one line (the principal
+    axis of the vertices): a flat polygon, which shapely also calls invalid."""
+    centred = poly - poly.mean(0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]  # unit direction of the line
+    off = np.abs(centred @ np.array([-axis[1], axis[0]]))  # distances from it (m)
+    return float(np.max(off)) <= rel * max(1.0, float(np.max(np.ptp(poly, axis=0))))
 
 
 def _float_array(vertices, name: str) -> np.ndarray:

@@ -22,7 +22,7 @@ shipped ones.
 from __future__ import annotations
 
 import inspect
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -228,11 +228,11 @@ class Robot:
         return float(np.max(hops[body] + np.linalg.norm(self.nodes0 - o[body], axis=1)))
 
     # ---------------------------------------------------------------- sampling and checks
-    def sample(self, n: int, seed: int | None = 0) -> np.ndarray:
+    def sample(self, n: int, seed: int | Sequence[int] | None = 0) -> np.ndarray:
         """(n, dof) configurations uniform within the joint limits; n an integer in
-        [0, MAX_SAMPLES], else InputError."""
+        [0, MAX_SAMPLES] and ``seed`` as :func:`check_seed` allows, else InputError."""
         check_int(n, "n", 0, MAX_SAMPLES)
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng(check_seed(seed))
         return rng.uniform(self.lower, self.upper, size=(n, self.dof))
 
     def check_q(self, q: np.ndarray, name: str = "q") -> np.ndarray:
@@ -258,10 +258,9 @@ class Robot:
 
     def link_polygons(self, q: np.ndarray) -> list[np.ndarray]:
         """World polygons (m_k, 2) of one configuration q (dof,)."""
-        q = np.asarray(q, dtype=float)
-        if q.ndim != 1:
-            raise InputError(f"q: expected one configuration of shape ({self.dof},), got {q.shape}")
-        nodes = self.node_positions(q[None])[0]
+        if np.ndim(q) != 1:
+            raise InputError(f"q: expected one configuration of shape ({self.dof},), got {q!r}")
+        nodes = self.node_positions(q)[0]
         return [nodes[self.node_polygon == i] for i in range(self.n_links)]
 
     def body_poses(self, q: np.ndarray) -> np.ndarray:
@@ -343,18 +342,52 @@ def first_outside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, tol: floa
     return int(out[0]) if out.size else None
 
 
-def as_batch(q: np.ndarray, dof: int, name: str = "q") -> np.ndarray:
-    """Return q as a float64 (B, dof) array; a single (dof,) configuration becomes (1, dof)."""
+_KINDS = {"b": "booleans", "U": "strings", "S": "bytes", "c": "complex numbers", "O": "objects"}
+
+
+def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
+    """Return q as a float64 (B, dof) array; a single (dof,) configuration becomes (1, dof).
+
+    InputError naming ``name`` unless q holds real numbers (numpy kinds integer, unsigned or
+    float): booleans, strings, complex numbers and other objects are refused, not coerced
+    (``"0.1"`` is no angle, ``True`` no 1 rad, 1 + 2j loses its imaginary part).
+    """
     try:
-        q = np.asarray(q, dtype=float)
+        arr = np.asarray(q)
     except (TypeError, ValueError) as e:
         raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from e
-    if q.ndim not in (1, 2) or q.shape[-1] != dof:
-        raise InputError(f"{name}: expected shape (B, {dof}) or ({dof},), got {q.shape}")
-    q = q.reshape(-1, dof)
+    if arr.dtype.kind not in "iuf" or _holds_bool(q):
+        kind = "b" if arr.dtype.kind in "iuf" else arr.dtype.kind
+        what = _KINDS.get(kind, f"an array of {arr.dtype}")
+        raise InputError(f"{name}: expected real numbers (rad), got {what}")
+    if arr.ndim not in (1, 2) or arr.shape[-1] != dof:
+        raise InputError(f"{name}: expected shape (B, {dof}) or ({dof},), got {arr.shape}")
+    q = arr.astype(float, copy=False).reshape(-1, dof)
     if not np.all(np.isfinite(q)):
         raise InputError(f"{name}: contains NaN or infinite values")
     return q
+
+
+def _holds_bool(q) -> bool:
+    """True when a (nested) list or tuple holds a boolean: numpy reads [True, 0.5] as float64
+    and the boolean vanishes, so the elements themselves are looked at."""
+    if not isinstance(q, (list, tuple)):
+        return False
+    return any(isinstance(x, (bool, np.bool_)) for x in np.asarray(q, dtype=object).ravel())
+
+
+def check_seed(seed, name: str = "seed"):
+    """A seed numpy's ``default_rng`` takes, else InputError: None (fresh entropy), an integer
+    ≥ 0 or a non-empty sequence of them; booleans are refused (``True`` is no seed)."""
+    if seed is None:
+        return None
+    items = seed if isinstance(seed, (list, tuple)) and seed else [seed]
+    for x in items:
+        if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)) or x < 0:
+            raise InputError(
+                f"{name}: expected None, an integer ≥ 0 or a list of them, got {seed!r}"
+            )
+    return seed
 
 
 # -------------------------------------------------------------------- registry
