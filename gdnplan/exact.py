@@ -34,11 +34,13 @@ from .ccd import Certificate, certify_path, motion_bound
 from .distance import closest, signed_distance
 from .errors import InputError
 from .robot import Robot
-from .scene import Scene
+from .scene import Scene, check_scene
 
 
 def _unknown(what, kind: str):
-    return InputError(f"{kind}: expected a planar Scene or a Scene3D, got {type(what).__name__}")
+    if kind == "scene":
+        check_scene(what, "any")  # raises: singledispatch found neither scene kind
+    return InputError(f"{kind}: expected a planar Robot or a Robot3D, got {type(what).__name__}")
 
 
 @singledispatch

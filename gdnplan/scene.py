@@ -74,6 +74,10 @@ class Scene:
     info: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        _check_robot(self.robot)
+        if not isinstance(self.obstacles, (list, tuple, np.ndarray)):
+            got = _describe(self.obstacles)
+            raise InputError(f"obstacles: expected a list of (m, 2) polygons, got {got}")
         if len(self.obstacles) > MAX_OBSTACLES:
             raise InputError(
                 f"obstacles: {len(self.obstacles)} polygons, the limit is {MAX_OBSTACLES}"
@@ -115,6 +119,46 @@ class Scene:
     def with_obstacles(self, obstacles) -> Scene:
         """The same robot with other obstacles."""
         return replace(self, obstacles=tuple(obstacles))
+
+
+def _describe(value) -> str:
+    """A value's type for messages, with the value itself when it is short (``str 'b'``)."""
+    text = repr(value)
+    return type(value).__name__ + (f" {text}" if len(text) <= 40 else "")
+
+
+def _check_robot(robot) -> None:
+    """InputError unless ``robot`` is a planar :class:`Robot` (a Robot3D belongs in a Scene3D)."""
+    if isinstance(robot, Robot):
+        return
+    from .arm3d.robot3d import Robot3D  # on demand: arm3d imports this module
+
+    if isinstance(robot, Robot3D):
+        raise InputError("robot: a 3-D robot (Robot3D): use gdnplan.arm3d.Scene3D")
+    raise InputError(f"robot: expected a Robot (gdnplan.load_robot), got {_describe(robot)}")
+
+
+KINDS = {"planar": "a planar Scene", "3d": "a Scene3D", "any": "a planar Scene or a Scene3D"}
+
+
+def check_scene(scene, kind: str = "planar", use: str = "", name: str = "scene") -> None:
+    """The one type check of every public function taking a scene: InputError naming ``name``
+    unless ``scene`` is a planar :class:`Scene` (``kind="planar"``), a
+    :class:`~gdnplan.arm3d.Scene3D` (``"3d"``) or either (``"any"``). ``use`` names the function
+    for the other kind (``"gdnplan.arm3d.signed_distance3d"``), which the message points to."""
+    if isinstance(scene, Scene) and kind != "3d":
+        return
+    from .arm3d.scene3d import Scene3D  # on demand: arm3d imports this module
+
+    if isinstance(scene, Scene3D) and kind != "planar":
+        return
+    if isinstance(scene, (Scene, Scene3D)):
+        other = "a 3-D scene (Scene3D)" if isinstance(scene, Scene3D) else "a planar scene (Scene)"
+        raise InputError(f"{name}: {other}: use {use}" if use else f"{name}: {other}")
+    hint = ""
+    if isinstance(scene, str) and kind != "3d" and scene in SCENES:
+        hint = f"; build it first: gdnplan.make_scene({scene!r})"
+    raise InputError(f"{name}: expected {KINDS[kind]}, got {_describe(scene)}{hint}")
 
 
 # -------------------------------------------------------------------- generators

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..scene import check_scene
 from .gradient3d import pair_gradients
 from .narrow3d import PairTable, check_cap
 from .scene3d import Scene3D
@@ -57,6 +58,10 @@ class Checker3D(PairTable):
         tolerance: GJK and EPA tolerance of coal's request (coal's default 1e-6 when None);
             distances are within about ``tolerance · (1 + |d|)`` m of the exact ones.
     """
+
+    def __init__(self, scene: Scene3D, tolerance: float | None = None):
+        check_scene(scene, "3d", "gdnplan.distance.CoalChecker")
+        super().__init__(scene, tolerance)
 
     def scan(self, q: np.ndarray, per_link: bool, cap: float, broad_phase: bool, placed=None):
         """Minimising pairs of one configuration: (targets T; T = 1 or L) arrays of distance,
@@ -107,7 +112,6 @@ class Checker3D(PairTable):
         return pair_gradients(self, q, pair, p1, p2, normal)
 
     # ------------------------------------------------------------------ batches
-    # ------------------------------------------------------------------ batches
     def evaluate(
         self,
         q: np.ndarray,
@@ -147,6 +151,7 @@ _CHECKERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 def checker3d(scene: Scene3D, tolerance: float | None = None) -> Checker3D:
     """The cached :class:`Checker3D` of a scene (one per tolerance)."""
+    check_scene(scene, "3d", "gdnplan.distance.checker")
     per_scene = _CHECKERS.setdefault(scene, {})
     if tolerance not in per_scene:
         per_scene[tolerance] = Checker3D(scene, tolerance)
@@ -161,6 +166,7 @@ def signed_distance3d(
     Positive when free, minus the penetration depth when overlapping (obstacles and enabled
     self-collision pairs); ``cap`` where every pair's lower bound reaches ``cap``.
     """
+    check_scene(scene, "3d", "gdnplan.signed_distance")
     return checker3d(scene).evaluate(q, per_link, cap, broad_phase).distance
 
 
@@ -168,6 +174,7 @@ def signed_distance3d_and_grad(
     scene: Scene3D, q, per_link: bool = False, cap: float = np.inf, broad_phase: bool = True
 ) -> tuple[np.ndarray, np.ndarray]:
     """Signed distance and its exact gradient: ((B,), (B, dof)) or ((B, L), (B, L, dof))."""
+    check_scene(scene, "3d", "gdnplan.signed_distance_and_grad")
     res = checker3d(scene).evaluate(q, per_link, cap, broad_phase, gradient=True)
     return res.distance, res.gradient
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..limits import check_int, check_number
+from ..robot import Robot, check_seed
 from .robot3d import Robot3D
 from .shapes import as_pose, bounding_sphere, box, capsule, convex, cylinder, load_mesh, sphere
 
@@ -93,7 +94,14 @@ class Scene3D:
 
     def __init__(self, robot: Robot3D, obstacles: Sequence[Obstacle3D] = ()):
         if not isinstance(robot, Robot3D):
-            raise InputError(f"robot: expected a Robot3D, got {type(robot).__name__}")
+            hint = "; a planar Robot belongs in gdnplan.Scene" if isinstance(robot, Robot) else ""
+            raise InputError(f"robot: expected a Robot3D, got {type(robot).__name__}{hint}")
+        if isinstance(obstacles, Scene3D):
+            raise InputError("obstacles: got a Scene3D; pass its obstacles (scene.obstacles)")
+        if not isinstance(obstacles, (list, tuple)):
+            raise InputError(
+                f"obstacles: expected a list of Obstacle3D, got {type(obstacles).__name__}"
+            )
         obstacles = tuple(obstacles)
         if len(obstacles) > MAX_OBSTACLES:
             raise InputError(f"obstacles: {len(obstacles)} given, the limit is {MAX_OBSTACLES}")
@@ -110,7 +118,8 @@ class Scene3D:
 def workspace_radius(robot: Robot3D, samples: int = 256, seed: int = 0) -> float:
     """Radius (m) around the base origin that encloses every link shape's bounding sphere at
     ``samples`` random configurations (an estimate of the arm's reach)."""
-    rng = np.random.default_rng(seed)
+    check_int(samples, "samples", 1, 10**6)
+    rng = np.random.default_rng(check_seed(seed))
     centers = np.array([s.center for s in robot.shapes])
     radii = np.array([s.radius for s in robot.shapes])
     reach = 0.0
@@ -132,6 +141,7 @@ def random_boxes(
     of the ball of radius :func:`workspace_radius` (z ≥ 0), sides uniform in ``size`` (m),
     centres farther than ``base_clearance`` (m) from the base's vertical axis."""
     check_int(n, "n", 0, MAX_OBSTACLES)
+    check_seed(seed)
     lo = check_number(size[0], "size[0]", 0.0, strict=True)
     hi = check_number(size[1], "size[1]", lo)
     clearance = check_number(base_clearance, "base_clearance")
