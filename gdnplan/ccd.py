@@ -24,8 +24,13 @@ with ``COAL_SLACK`` = 2 τ. (A test compares coal with shapely's exact planar di
 round, one batched coal call) until every piece is proven by (1) to stay above the margin — or
 a checked configuration is within the margin (a counterexample), a piece shrinks below
 ``MIN_PIECE`` without a proof, or the check budget runs out: all three are failures, never
-acceptances. Pieces are also bisected until their bound is within ``tol`` of the smallest
-checked distance, so the reported lower bound is at most ``tol`` below the path's true minimum.
+acceptances. The budget is checked before any coal call: when the initial pieces alone need
+more than ``max_checks`` evaluations ((K − 1) · min_splits + 1 for K ≥ 2 waypoints, 2 for one
+configuration: both ends of its zero-length piece), the result is
+``ok=False`` with ``n_checks=0`` and the reason, nothing evaluated or allocated; ``n_checks``
+never exceeds ``max_checks`` and ``ok`` always comes with ``reason == ""``. Pieces are also
+bisected until their bound is within ``tol`` of the smallest checked distance, so the
+reported lower bound is at most ``tol`` below the path's true minimum.
 """
 
 from __future__ import annotations
@@ -42,10 +47,12 @@ from .distance import signed_distance
 from .errors import InputError
 from .limits import check_int, check_number, is_number
 from .robot import Robot
-from .scene import Scene
+from .scene import Scene, check_scene
 
 COAL_SLACK = 2 * coal.DistanceRequest().gjk_tolerance  # relative error allowance of coal (m/m)
 MIN_PIECE = 1e-9  # m: a piece whose robot points move less than this is not bisected further
+MAX_SPLITS = 10_000  # min_splits: initial pieces per waypoint segment (bisection refines them)
+MAX_CHECKS = 10**8  # max_checks: coal evaluations of one certificate (hours of coal time)
 
 
 @cache
@@ -105,7 +112,7 @@ class Certificate:
             smallest bound (1) of all pieces; −inf when ``ok`` is False (nothing is proven).
         min_distance: smallest coal distance over all checked configurations (m): an upper
             bound on the path's minimum, and the counterexample's distance when it is ≤ margin.
-        n_checks: coal evaluations made.
+        n_checks: coal evaluations made, at most the ``max_checks`` asked for.
         bad_segments: indices of the waypoint segments holding a configuration within the
             margin or a piece left unproven (too small to bisect, or out of check budget).
         reason: why the certificate failed ("" when ``ok``).
@@ -123,8 +130,8 @@ def _check_args(margin: float, tol: float, min_splits: int, max_checks: int) -> 
     check_number(margin, "margin")
     if not (is_number(tol) and tol > 0) or math.isnan(tol):
         raise InputError(f"tol: expected a number > 0 (m) or inf, got {tol!r}")
-    check_int(min_splits, "min_splits", 1, 10**6)
-    check_int(max_checks, "max_checks", 1, 10**9)
+    check_int(min_splits, "min_splits", 1, MAX_SPLITS)
+    check_int(max_checks, "max_checks", 1, MAX_CHECKS)
 
 
 def _initial_pieces(q_path: np.ndarray, splits: int):
@@ -137,6 +144,21 @@ def _initial_pieces(q_path: np.ndarray, splits: int):
     ends = (q_path[:-1, None] + s[None, 1:, None] * step).reshape(-1, q_path.shape[1])
     ends[splits - 1 :: splits] = q_path[1:]  # pieces meet the waypoints exactly
     return starts, ends, np.repeat(np.arange(len(q_path) - 1), splits)
+
+
+def _over_budget(n_waypoints: int, splits: int, max_checks: int) -> Certificate | None:
+    """The failed certificate when the initial pieces of a path of ``n_waypoints`` need more
+    than ``max_checks`` coal evaluations (the pieces' ends), else None; nothing is checked."""
+    segments = max(n_waypoints - 1, 1)
+    needed = (1 if n_waypoints == 1 else segments * splits) + 1  # the pieces' ends
+    if needed <= max_checks:
+        return None
+    reason = (
+        f"the check budget ({max_checks} coal evaluations) cannot hold the {needed} checks of "
+        f"the initial pieces' ends ({splits} per waypoint segment); raise max_checks or lower "
+        "min_splits"
+    )
+    return Certificate(False, -math.inf, math.inf, 0, tuple(range(segments)), reason)
 
 
 def certify_path(
@@ -156,10 +178,12 @@ def certify_path(
         margin: clearance to prove (m), finite and ≥ 0.
         tol: bisect until the reported lower bound is within ``tol`` of the smallest checked
             distance (m); ``math.inf`` proves the margin only (fastest, e.g. for edge checks).
-        min_splits: pieces each waypoint segment starts with.
+        min_splits: pieces each waypoint segment starts with, at most ``MAX_SPLITS``.
         stop_early: return at the first configuration within the margin.
-        max_checks: coal evaluations allowed; running out is a failure.
+        max_checks: coal evaluations allowed; running out is a failure (also when the
+            initial pieces alone exceed it: then ``n_checks`` is 0, module docstring).
     """
+    check_scene(scene, use="gdnplan.arm3d.certify_path3d")
     _check_args(margin, tol, min_splits, max_checks)
     robot = scene.robot
     q_path = robot.check_q(q_path, "q_path")
@@ -192,8 +216,12 @@ def certify_by_bisection(
     ``distance(q)`` (B, dof) → (B,) is the exact signed distance (m) and ``motion(qa, qb)``
     bounds how far any point of the robot moves between qa and qb (B, dof) → (B,) (m); a piece
     is proven when (d_a + d_b − motion) / 2 > margin (and within ``tol`` of the smallest checked
-    distance), else it is bisected. Arguments are checked by the caller.
+    distance), else it is bisected. Arguments are checked by the caller; ``n_checks`` stays
+    within ``max_checks`` (:func:`_over_budget` before the first call).
     """
+    failed = _over_budget(len(q_path), min_splits, max_checks)
+    if failed is not None:
+        return failed
     qa, qb, seg = _initial_pieces(q_path, min_splits)
     nodes = np.concatenate([qa, qb[-1:]])
     raw = distance(nodes)
@@ -233,7 +261,7 @@ def certify_by_bisection(
         qa, qb = np.concatenate([qa, mid]), np.concatenate([mid, qb])
         da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
         seg = np.concatenate([seg, seg])
-    ok = not bad
+    ok = not bad and not reasons
     reason = "; ".join(dict.fromkeys(reasons))
     return Certificate(
         ok, lower if ok else -math.inf, raw_min, n_checks, tuple(sorted(bad)), reason
@@ -243,6 +271,7 @@ def certify_by_bisection(
 def verify_path(scene: Scene, q_path: np.ndarray, margin: float = 0.0) -> tuple[bool, float]:
     """Certified coal check of a joint path (K, dof): (proven to stay above ``margin``, proven
     lower bound on its clearance in m, −inf when not proven)."""
+    check_scene(scene, use="gdnplan.arm3d.certify_path3d")
     cert = certify_path(scene, q_path, margin=margin)
     return cert.ok, cert.lower_bound
 

@@ -27,10 +27,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ccd import MIN_PIECE, proven_distance
+from .ccd import MAX_CHECKS, MAX_SPLITS, MIN_PIECE, proven_distance
 from .errors import InputError
 from .exact import exact_distance, motion_bound_of
 from .limits import check_int, check_number
+from .scene import check_scene
 
 CURVE_SPLITS = 4  # pieces each knot interval starts with
 CURVE_MAX_CHECKS = 200_000  # coal evaluations allowed
@@ -61,7 +62,8 @@ def _total_variation(curve, sa: np.ndarray, sb: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class CurveCertificate:
     """Result of :func:`certify_curve`: ``ok`` proves coal distance > margin on the whole curve;
-    ``lower_bound`` the proven bound (m, −inf unless ok); ``n_checks`` coal evaluations."""
+    ``lower_bound`` the proven bound (m, −inf unless ok); ``n_checks`` coal evaluations, at
+    most ``max_checks`` (initial pieces needing more fail before any call, ``n_checks`` 0)."""
 
     ok: bool
     lower_bound: float
@@ -88,15 +90,18 @@ def certify_curve(
         splits: pieces each knot interval starts with.
         max_checks: coal evaluations allowed; running out is a failure.
     """
+    check_scene(scene, "any")
     check_number(margin, "margin")
     check_number(tol, "tol", strict=True)
-    check_int(splits, "splits", 1, 10**6)
-    check_int(max_checks, "max_checks", 1, 10**9)
+    check_int(splits, "splits", 1, MAX_SPLITS)
+    check_int(max_checks, "max_checks", 1, MAX_CHECKS)
     if curve.c.ndim != 3 or curve.c.shape[0] != 4 or curve.c.shape[2] != scene.robot.dof:
         raise InputError(f"curve: expected a cubic PPoly of {scene.robot.dof} joints")
     robot = scene.robot
     zero = np.zeros(robot.dof)
     x = curve.x
+    if (len(x) - 1) * splits + 1 > max_checks:  # the initial nodes alone: fail before any call
+        return CurveCertificate(False, -math.inf, 0)
     s = np.linspace(0.0, 1.0, splits + 1)
     nodes = np.unique((x[:-1, None] + s[None] * np.diff(x)[:, None]).ravel())
     nodes = np.unique(np.concatenate([nodes, x]))

@@ -35,9 +35,10 @@ import weakref
 
 import numpy as np
 
-from ..ccd import Certificate, certify_by_bisection
+from ..ccd import MAX_CHECKS, MAX_SPLITS, Certificate, certify_by_bisection
 from ..errors import InputError
 from ..limits import check_int, check_number, is_number
+from ..scene import check_scene
 from .distance3d import checker3d
 from .robot3d import Robot3D
 from .scene3d import Scene3D
@@ -113,11 +114,14 @@ def certify_path3d(
     ``tol`` (m): also bisect until the reported lower bound is within ``tol`` of the smallest
     checked distance (inf: prove the margin only); ``stop_early``: return at the first
     configuration within the margin. Returns a :class:`gdnplan.ccd.Certificate`; ``ok`` only
-    with a proof on every piece.
+    with a proof on every piece (then ``reason`` is ""). ``min_splits`` ≤ ``MAX_SPLITS``; the
+    budget ``max_checks`` is never exceeded: initial pieces needing more fail before any coal
+    call (``ok=False``, ``n_checks=0``, the reason; :mod:`gdnplan.ccd`).
     """
+    check_scene(scene, "3d", "gdnplan.certify_path")
     check_number(margin, "margin")
-    check_int(min_splits, "min_splits", 1, 10**6)
-    check_int(max_checks, "max_checks", 1, 10**9)
+    check_int(min_splits, "min_splits", 1, MAX_SPLITS)
+    check_int(max_checks, "max_checks", 1, MAX_CHECKS)
     if not (is_number(tol) and tol > 0):
         raise InputError(f"tol: expected a number > 0 (m) or inf, got {tol!r}")
     robot = scene.robot
