@@ -6,10 +6,22 @@ The paper's collision distance (§IV-D) between the robot R(q) and obstacles O_1
             = −max_i depth(R(q), O_i)        otherwise (penetration depth),
 
 which is the minimum of coal's signed distances over all (link polygon, convex obstacle part)
-pairs. Polygons become tall convex prisms (±``PRISM_HALF_HEIGHT`` in z, so the penetration
-solver cannot escape through z). For the winning pair coal returns witness points p₁ (on the
-link) and p₂ (on the obstacle) and the unit normal n from shape 1 to shape 2 with
-d = n · (p₂ − p₁). As only p₁ moves,
+pairs. Polygons become tall convex prisms, ±H in z with H = :func:`prism_half_height` of the
+scene, so the penetration solver cannot escape through z: two prisms of one height overlap by
+2H in z, while the in-plane depth of a link polygon A and an obstacle part B is at most
+min_n (w_A(n) + w_B(n)) / 2 ≤ r_A + r_B (w the widths along n, r the bounding-circle radii), so
+
+    H = max(``MIN_PRISM_HALF_HEIGHT``, ``PRISM_SAFETY`` · (max_A r_A + max_B r_B))
+
+makes the z escape cost 2H at least 2 · ``PRISM_SAFETY`` times any in-plane depth of the
+scene. Every shipped scene keeps H = 1 m (its prisms as before); obstacles up to
+:func:`gdnplan.scene.coordinate_bound` make H a few hundred metres. Apart
+shapes do not depend on H (GJK, unchanged values); overlapping ones go to EPA, whose tolerance
+``EPA_TOLERANCE`` is tight enough that tall prisms keep the depth exact to ~1e-15 (coal's
+default 1e-6 lost 1e-3 relative at H = 3 km, tests/test_distance_depth.py).
+
+For the winning pair coal returns witness points p₁ (on the link) and p₂ (on the obstacle)
+and the unit normal n from shape 1 to shape 2 with d = n · (p₂ − p₁). As only p₁ moves,
 
     ∂d/∂q_j = −n · ∂p₁/∂q_j = −n · s_j ẑ × (p₁ − o_j(q))   for every joint j upstream of the link,
 
@@ -29,16 +41,25 @@ import coal
 import numpy as np
 
 from .robot import cross_z
-from .scene import Scene
+from .scene import Scene, check_scene
 
-PRISM_HALF_HEIGHT = 1.0  # m
+MIN_PRISM_HALF_HEIGHT = 1.0  # m: the prisms' half-height in small scenes (all shipped ones)
+PRISM_SAFETY = 1.0  # half-height / (largest link radius + largest part radius)
+EPA_TOLERANCE = 1e-9  # coal's EPA stopping tolerance (its default 1e-6 is too loose, above)
 PARALLEL_MIN_BATCH = 2000  # batches at least this large are split over all cores
 
 
-def _prism(poly: np.ndarray) -> coal.ConvexBase:
-    """Tall convex prism over a convex polygon (m, 2)."""
-    top = np.c_[poly, np.full(len(poly), PRISM_HALF_HEIGHT)]
-    bottom = np.c_[poly, np.full(len(poly), -PRISM_HALF_HEIGHT)]
+def prism_half_height(scene: Scene) -> float:
+    """H (m) of the module docstring: the prisms' half-height for this scene's shapes."""
+    radii = [_circle(p.vertices0)[1] for p in scene.robot.polygons]
+    radii_parts = [_circle(p)[1] for p in scene.obstacle_parts] or [0.0]
+    return max(MIN_PRISM_HALF_HEIGHT, PRISM_SAFETY * (max(radii) + max(radii_parts)))
+
+
+def _prism(poly: np.ndarray, half_height: float) -> coal.ConvexBase:
+    """Convex prism over a convex polygon (m, 2), ±half_height (m) in z."""
+    top = np.c_[poly, np.full(len(poly), half_height)]
+    bottom = np.c_[poly, np.full(len(poly), -half_height)]
     points = coal.StdVec_Vec3s()
     for p in np.vstack([top, bottom]):
         points.append(p)
@@ -65,21 +86,24 @@ class CoalChecker:
     """Coal shapes and distance functors of one scene, reused across calls."""
 
     def __init__(self, scene: Scene):
+        check_scene(scene, use="gdnplan.arm3d.Checker3D")
         robot = scene.robot
         self.robot = robot
-        self.link_shapes = [_prism(p.vertices0) for p in robot.polygons]
+        self.half_height = height = prism_half_height(scene)
+        self.link_shapes = [_prism(p.vertices0, height) for p in robot.polygons]
         self.link_body = np.array([p.body for p in robot.polygons])
         circles = [_circle(p.vertices0) for p in robot.polygons]
         self.link_center0 = np.array([c for c, _ in circles]).reshape(-1, 2)
         self.link_radius = np.array([r for _, r in circles])
         parts = scene.obstacle_parts
-        self.part_shapes = [_prism(p) for p in parts]
+        self.part_shapes = [_prism(p, height) for p in parts]
         circles = [_circle(p) for p in parts]
         self.part_center = np.array([c for c, _ in circles]).reshape(-1, 2)
         self.part_radius = np.array([r for _, r in circles])
         self.identity = coal.Transform3s()
         self.request = coal.DistanceRequest()
         self.request.enable_signed_distance = True
+        self.request.epa_tolerance = EPA_TOLERANCE
         self.result = coal.DistanceResult()
         self.functors = [
             [coal.ComputeDistance(ls, ps) for ps in self.part_shapes] for ls in self.link_shapes
@@ -161,6 +185,7 @@ _CHECKERS: weakref.WeakKeyDictionary[Scene, CoalChecker] = weakref.WeakKeyDictio
 
 def checker(scene: Scene) -> CoalChecker:
     """The cached :class:`CoalChecker` of a scene."""
+    check_scene(scene, use="gdnplan.arm3d.checker3d")
     if scene not in _CHECKERS:
         _CHECKERS[scene] = CoalChecker(scene)
     return _CHECKERS[scene]
@@ -214,6 +239,7 @@ def signed_distance(scene: Scene, q: np.ndarray, per_link: bool = False) -> np.n
     Positive when free, negative (minus the penetration depth) when overlapping. Batches of
     ``PARALLEL_MIN_BATCH`` or more are split over the machine's cores.
     """
+    check_scene(scene, use="gdnplan.arm3d.signed_distance3d")
     q = scene.robot.check_q(q)
     return closest(scene, q, per_link).distance
 
@@ -222,6 +248,7 @@ def signed_distance_and_grad(
     scene: Scene, q: np.ndarray, per_link: bool = False
 ) -> tuple[np.ndarray, np.ndarray]:
     """Signed distance and its exact gradient: ((B,), (B, dof)) or ((B, L), (B, L, dof))."""
+    check_scene(scene, use="gdnplan.arm3d.signed_distance3d_and_grad")
     q = scene.robot.check_q(q)
     w = closest(scene, q, per_link)
     return w.distance, witness_gradient(scene, q, w)
@@ -229,6 +256,7 @@ def signed_distance_and_grad(
 
 def witness(scene: Scene, q: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     """Distance and the witness segment (p_robot, p_obstacle) of one configuration, for plots."""
+    check_scene(scene, use="gdnplan.arm3d.signed_distance3d")
     q = scene.robot.check_q(q)
     w = checker(scene).closest(q[:1], per_link=False)
     d, p1, n = float(w.distance[0]), w.point[0], w.normal[0]
