@@ -62,17 +62,21 @@ def hide_progress() -> None:
     logger.setLevel(logging.NOTSET)
 
 
-THREADS_HELP = "torch threads for learned models (1 is fastest on a busy or 2-core CPU)."
+THREADS_HELP = (
+    "torch threads for learned models, 1 … max(256, 4 per core); 1 is fastest on a busy or "
+    "2-core CPU."
+)
 
 
 def set_threads(threads: int, torch_global: bool = False) -> None:
     """The learned models' inference threads (:mod:`gdnplan.models.threads`) and, with
-    ``torch_global`` (training, table runs), torch's own intra-op threads; InputError unless
-    threads ≥ 1. Without ``torch_global`` torch is not imported (coal-only commands)."""
-    if threads < 1:
-        raise InputError(f"--threads: expected ≥ 1, got {threads}")
-    from ..models.threads import set_inference_threads
+    ``torch_global`` (training, table runs), torch's own intra-op threads; InputError naming
+    ``--threads`` unless threads is an integer in 1 … ``MAX_THREADS`` (4 per core, at least
+    256; :func:`gdnplan.models.threads.check_threads`), checked before anything is set. Without
+    ``torch_global`` torch is not imported (coal-only commands)."""
+    from ..models.threads import check_threads, set_inference_threads
 
+    threads = check_threads(threads, "--threads", default=False)
     set_inference_threads(threads)
     if torch_global:
         import torch

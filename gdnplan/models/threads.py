@@ -6,7 +6,7 @@ cores other jobs hold make every call slower (``benchmarks/threads.py`` measures
 side by side). So GraphDistNet and ClearanceNet run their inference under a thread count of
 their own, ``model.threads``:
 
-- an integer ≥ 1: that many threads;
+- an integer in 1 … :data:`MAX_THREADS`: that many threads;
 - ``None`` (the default): the library default, :func:`inference_threads`, which is 1 unless
   :func:`set_inference_threads` changed it (the CLI's ``--threads``).
 
@@ -16,25 +16,40 @@ the caller's own torch work keeps its setting. Torch's thread count is process-w
 threads running inference under different counts at the same time see each other's setting.
 Training (:mod:`gdnplan.train`) uses torch's global setting (``gdnplan train --threads``), not
 this one. DiffCo is numpy only.
+
+Every thread count the library or the CLI takes (``threads=`` of the models and
+:func:`~gdnplan.load_model`, :func:`set_inference_threads`, every ``--threads``) passes
+:func:`check_threads`: an integer (not a bool) from 1 to :data:`MAX_THREADS`, four per core
+and at least 256. More threads than that never run faster, and counts far beyond it make
+OpenMP fail to allocate its pool (``libgomp: Out of memory``) or raise MemoryError inside the
+first inference instead of a clear error here.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 
 from ..errors import InputError
+from .fields import shown
 
 DEFAULT_THREADS = 1
+MAX_THREADS = max(256, 4 * (os.cpu_count() or 1))  # the largest count accepted (docstring)
 _DEFAULT = {"threads": DEFAULT_THREADS}
 
 
-def check_threads(threads: object, name: str = "threads") -> int | None:
-    """``threads`` when it is None or an integer ≥ 1, else InputError naming ``name``."""
-    if threads is None:
+def check_threads(threads: object, name: str = "threads", default: bool = True) -> int | None:
+    """``threads`` when it is None (only with ``default``) or an integer in 1 …
+    :data:`MAX_THREADS` (bools refused), else InputError naming ``name``."""
+    if threads is None and default:
         return None
-    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
-        raise InputError(f"{name}: expected an integer ≥ 1 (or None: the default), got {threads!r}")
+    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= MAX_THREADS:
+        none = " (or None: the default)" if default else ""
+        raise InputError(
+            f"{name}: expected an integer ≥ 1 and ≤ {MAX_THREADS} (the limit: 4 per core, at "
+            f"least 256){none}, got {shown(threads)}"
+        )
     return threads
 
 
@@ -44,10 +59,9 @@ def inference_threads() -> int:
 
 
 def set_inference_threads(threads: int) -> None:
-    """Set the torch threads of learned models whose ``threads`` is None (integer ≥ 1)."""
-    if check_threads(threads) is None:
-        raise InputError("threads: expected an integer ≥ 1, got None")
-    _DEFAULT["threads"] = threads
+    """Set the torch threads of learned models whose ``threads`` is None (an integer in
+    1 … :data:`MAX_THREADS`)."""
+    _DEFAULT["threads"] = check_threads(threads, default=False)
 
 
 @contextmanager
