@@ -241,12 +241,19 @@ def test_no_geometry_and_no_polygons(tmp_path):
     assert robot.n_links == 1 and robot.polygons[0].body == 1
 
 
-def test_geometry_flat_in_the_plane_is_refused(tmp_path):
-    flat = '<collision><geometry><box size="0.4 0 0.05"/></geometry></collision>'
+@pytest.mark.parametrize(
+    ("size", "match"),
+    [
+        ("0.4 0 0.05", r"link 'l1' <collision> 1 <box size>: '0.4 0 0.05' has a size outside"),
+        ("0.4 1.5e-6 0.05", r"'l1_0' of test_arm\.urdf projects to a segment"),
+    ],
+)
+def test_geometry_flat_in_the_plane_is_refused(tmp_path, size, match):
+    flat = f'<collision><geometry><box size="{size}"/></geometry></collision>'
     path = write_urdf(
         tmp_path, '<link name="base"/>', joint("j1", "base", "l1"), f'<link name="l1">{flat}</link>'
     )
-    with pytest.raises(InputError, match=r"'l1_0' of test_arm\.urdf projects to a segment"):
+    with pytest.raises(InputError, match=match):
         gp.robot_from_urdf("arm", RobotSpec(urdf=path, planning_joints=("j1",)))
 
 

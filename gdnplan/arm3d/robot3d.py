@@ -29,6 +29,7 @@ import pinocchio as pin
 from ..errors import InputError, UnknownNameError
 from ..robot import as_batch
 from ..urdf_robot import RobotSpec, load_urdf
+from ..urdf_robot.joint_limits import check_joint_limits
 from ..urdf_robot.load import check_mimic
 from ..urdf_robot.locking import lock_mimics, set_locked
 from .pairs import self_collision_pairs
@@ -196,6 +197,7 @@ def robot3d_from_urdf(
     if joints is None and any(model.joints[model.getJointId(j)].nq == 2 for j in planning):
         model, geom = load_urdf(RobotSpec(path, tuple(planning), package_dirs=dirs))
     _check_joints(model, planning, movable, path.name)
+    check_joint_limits(model, planning, path)
     check_mimic(path, planning)
     q_ref = _locked_configuration(model, planning, locked or {}, path.name)
     lock_mimics(model, q_ref, path, set(locked or {}))

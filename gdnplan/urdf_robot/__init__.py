@@ -20,14 +20,18 @@ Modules: :mod:`~gdnplan.urdf_robot.spec` (:class:`RobotSpec`), :mod:`~gdnplan.ur
 (the robot from a URDF or from built models), :mod:`~gdnplan.urdf_robot.checks` (plane axes,
 planning joints), :mod:`~gdnplan.urdf_robot.locking` (locked values and ``<mimic>`` followers,
 shared with the 3-D loader), :mod:`~gdnplan.urdf_robot.load` (URDF parsing with readable
-errors) and :mod:`~gdnplan.urdf_robot.shapes` (collision shapes → projected link polygons).
-Every public name is re-exported here.
+errors, shared with the 3-D loader: every ``<collision>`` loads or the file is refused),
+:mod:`~gdnplan.urdf_robot.xml_checks` (the numbers of collisions and origins),
+:mod:`~gdnplan.urdf_robot.meshes` (mesh files), :mod:`~gdnplan.urdf_robot.joint_limits`
+(joint limits, continuous planning joints) and :mod:`~gdnplan.urdf_robot.shapes` (collision
+shapes → projected link polygons). Every public name is re-exported here.
 """
 
 from __future__ import annotations
 
 from .build import robot_from_models, robot_from_urdf
 from .checks import AXIS_TOLERANCE, JOINT_KINDS, PLANE_TOLERANCE, REVOLUTE, plane_basis
+from .joint_limits import CONTINUOUS_VELOCITY, MAX_LIMIT
 from .load import load_urdf
 from .locking import CONTINUOUS
 from .shapes import geometry_points
@@ -36,7 +40,9 @@ from .spec import RobotSpec
 __all__ = [
     "AXIS_TOLERANCE",
     "CONTINUOUS",
+    "CONTINUOUS_VELOCITY",
     "JOINT_KINDS",
+    "MAX_LIMIT",
     "PLANE_TOLERANCE",
     "REVOLUTE",
     "RobotSpec",

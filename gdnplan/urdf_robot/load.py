@@ -1,31 +1,42 @@
-"""Reading a URDF into Pinocchio, with the parser's complaint as a one-line InputError."""
+"""Reading a URDF into Pinocchio, with every problem as a one-line InputError.
+
+Before urdfdom reads the file, its XML is checked (:mod:`~gdnplan.urdf_robot.xml_checks`:
+every number of the ``<collision>`` elements and of the origins; :mod:`~gdnplan.urdf_robot.meshes`:
+the mesh files). After, every link must have as many collision geometries as its XML has
+``<collision>`` elements: urdfdom drops an element it cannot parse with a complaint on stderr
+only, and a robot missing a shape would be certified collision-free where it is not. Joint
+limits are checked by :mod:`~gdnplan.urdf_robot.joint_limits`.
+"""
 
 from __future__ import annotations
 
-import contextlib
-import os
-import tempfile
 import xml.etree.ElementTree as ET
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
+from .joint_limits import check_joint_limits, make_continuous_revolute, unlimit_effort
+from .meshes import check_meshes
 from .spec import RobotSpec
+from .stderr import stderr_captured
+from .xml_checks import MAX_OFFSET, check_urdf_xml, collision_counts
 
 AXIS_UNIT_TOLERANCE = 1e-9  # largest | |axis| − 1 | of a joint axis after Pinocchio's parse
-MAX_OFFSET = 1e3  # m: largest |coordinate| of a joint origin or a collision origin
+__all__ = ["MAX_OFFSET", "check_mimic", "load_urdf", "stderr_captured"]
 
 
 def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     """Pinocchio model and collision geometry of ``spec.urdf``.
 
     Continuous planning joints become revolute joints limited to [−π, π] (Pinocchio gives a
-    continuous joint two coordinates, cos θ and sin θ). UnknownNameError for a missing file;
-    InputError for one that does not parse, with the parser's first complaint, and for a
-    planning joint that is a ``<mimic>`` joint or is mimicked (:func:`check_mimic`).
+    continuous joint two coordinates, cos θ and sin θ; see
+    :mod:`~gdnplan.urdf_robot.joint_limits` for their velocity). UnknownNameError for a
+    missing file; InputError for one that does not parse, with the parser's first complaint,
+    for a malformed ``<collision>``, origin, mesh file or joint limit (naming the link or
+    joint and the attribute), and for a planning joint that is a ``<mimic>`` joint or is
+    mimicked (:func:`check_mimic`).
     """
     path = Path(spec.urdf)
     try:
@@ -40,40 +51,62 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
         reason = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
     _check_mimic(root, spec.planning_joints, path)
-    _check_origins(root, path)
-    rewritten = False
-    for joint in root.iter("joint"):
-        if joint.get("type") == "continuous" and joint.get("name") in spec.planning_joints:
-            joint.set("type", "revolute")
-            limit = joint.find("limit")
-            if limit is None:
-                limit = ET.SubElement(joint, "limit", effort="0", velocity="0")
-            limit.set("lower", repr(-np.pi))
-            limit.set("upper", repr(np.pi))
-            rewritten = True
+    check_urdf_xml(root, path)
     packages = [str(p) for p in spec.package_dirs] + [str(p) for p in path.resolve().parents]
-    with _stderr_captured() as log:
+    check_meshes(root, path, packages)
+    bare = make_continuous_revolute(root, spec.planning_joints)
+    model, geom, log = _build(root, path, packages)
+    unlimit_effort(model, bare)
+    _check_joint_axes(model, path)
+    check_joint_limits(model, spec.planning_joints, path)
+    _check_counts(root, model, geom, path, log)
+    return model, geom
+
+
+def _build(
+    root: ET.Element, path: Path, packages: list[str]
+) -> tuple[pin.Model, pin.GeometryModel, list[str]]:
+    """The model and collision geometry of the checked XML ``root`` and urdfdom's stderr lines;
+    InputError with urdfdom's first complaint when it refuses the file."""
+    text = ET.tostring(root, encoding="unicode")
+    with stderr_captured() as log:
         try:
-            if rewritten:
-                text = ET.tostring(root, encoding="unicode")
-                model = pin.buildModelFromXML(text)
-                geom = pin.buildGeomFromUrdfString(
-                    model, text, pin.GeometryType.COLLISION, package_dirs=packages
-                )
-            else:
-                model = pin.buildModelFromUrdf(str(path))
-                geom = pin.buildGeomFromUrdf(
-                    model, str(path), pin.GeometryType.COLLISION, package_dirs=packages
-                )
+            model = pin.buildModelFromXML(text)
+            geom = pin.buildGeomFromUrdfString(
+                model, text, pin.GeometryType.COLLISION, package_dirs=packages
+            )
         except (ValueError, RuntimeError) as e:
             error = e
         else:
-            _check_joint_axes(model, path)
-            return model, geom
-    reason = next((line.strip() for line in log if line.strip().startswith("Error:")), "")
-    reason = (reason.removeprefix("Error:").strip() or str(error) or "no reason given").strip()
-    reason = reason.splitlines()[0]
-    raise InputError(f"urdf: {path} is not a valid URDF: {reason}") from error
+            return model, geom, log
+    reason = _complaint(log) or str(error).strip() or "no reason given"
+    raise InputError(f"urdf: {path} is not a valid URDF: {reason.splitlines()[0]}") from error
+
+
+def _complaint(log: list[str]) -> str:
+    """urdfdom's first "Error:" line without the prefix ("" when there is none)."""
+    line = next((x.strip() for x in log if x.strip().startswith("Error:")), "")
+    return line.removeprefix("Error:").strip()
+
+
+def _check_counts(
+    root: ET.Element, model: pin.Model, geom: pin.GeometryModel, path: Path, log: list[str]
+) -> None:
+    """InputError naming the first link with fewer (or more) collision geometries than its
+    ``<collision>`` elements: urdfdom dropped one without raising."""
+    loaded: dict[str, int] = {}
+    for obj in geom.geometryObjects:
+        link = model.frames[obj.parentFrame].name
+        loaded[link] = loaded.get(link, 0) + 1
+    expected = collision_counts(root)
+    for link in dict.fromkeys([*expected, *loaded]):
+        want, got = expected.get(link, 0), loaded.get(link, 0)
+        if want != got:
+            reason = _complaint(log) or "no reason given"
+            raise InputError(
+                f"urdf: {path.name}: link {link!r} has {want} <collision> element(s) but "
+                f"{got} reached the collision model (urdfdom: {reason}); fix the element"
+            )
 
 
 def _check_joint_axes(model: pin.Model, path: Path) -> None:
@@ -90,28 +123,6 @@ def _check_joint_axes(model: pin.Model, path: Path) -> None:
                 f"urdf: joint {model.names[j]!r} of {path.name} has the axis "
                 f"{np.asarray(axis, float).tolist()}, not a direction; give a nonzero "
                 '<axis xyz="x y z"/>'
-            )
-
-
-def _check_origins(root: ET.Element, path: Path) -> None:
-    """InputError naming the first joint or collision ``<origin xyz>`` beyond ``MAX_OFFSET``
-    along an axis: there floating point loses a link's position (a fixed joint 1e20 m out and
-    one −99999999999999999999.4 m back put a link at 0, not 0.6 m) and coal's distances
-    overflow, so no certificate would describe the URDF's robot."""
-    owners = [(f"joint {j.get('name')!r}", j) for j in root.iter("joint")]
-    owners += [(f"a collision of link {k.get('name')!r}", c) for k in root.iter("link")
-               for c in k.iter("collision")]  # fmt: skip
-    for what, element in owners:
-        origin = element.find("origin")
-        text = "" if origin is None else origin.get("xyz", "")
-        try:
-            xyz = np.array([float(x) for x in text.split()])
-        except ValueError:
-            continue  # urdfdom names the malformed number
-        if not np.all(np.abs(xyz) <= MAX_OFFSET):
-            raise InputError(
-                f"urdf: the origin of {what} in {path.name} is {xyz.tolist()} m, beyond "
-                f"{MAX_OFFSET:g} m along an axis; use metres near the robot"
             )
 
 
@@ -137,19 +148,3 @@ def _check_mimic(root: ET.Element, planning, path: Path) -> None:
                 "gdnplan moves planning joints independently and would not move them together: "
                 "lock both joints, or plan a URDF without the <mimic>"
             )
-
-
-@contextlib.contextmanager
-def _stderr_captured() -> Iterator[list[str]]:
-    """Collect what C++ code (urdfdom) writes to file descriptor 2 into a list of lines."""
-    lines: list[str] = []
-    saved = os.dup(2)
-    with tempfile.TemporaryFile(mode="w+") as tmp:
-        os.dup2(tmp.fileno(), 2)
-        try:
-            yield lines
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            tmp.seek(0)
-            lines.extend(tmp.read().splitlines())
