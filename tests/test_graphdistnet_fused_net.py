@@ -205,7 +205,8 @@ def test_point_parallel_candidates_equal_the_insertion_search(seed, partners, ca
     """The tile's candidates (vectorised over its points) are :func:`_nearest`'s, point by
     point: the same rows in the same order (ties to the lower row), d² and log φ, also with
     fewer partners than candidates (padded) and with repeated partners (exact ties)."""
-    from gdnplan.models.graphdistnet.fused_net_kernels import _nearest, _point_candidates
+    from gdnplan.models.graphdistnet.fused_net_kernels import _nearest
+    from gdnplan.models.graphdistnet.fused_search import point_candidates
 
     dtype = np.float32 if single else np.float64
     rng = np.random.default_rng(seed)
@@ -215,7 +216,7 @@ def test_point_parallel_candidates_equal_the_insertion_search(seed, partners, ca
     x = rng.uniform(-1.2, 1.2, (3, 5, 2)).astype(dtype)
     x[0, 0] = xo[-1]  # a point on a partner: d² = 0
     got = [np.empty((3, 5, cand), t) for t in (np.int64, dtype, dtype)]
-    _point_candidates(x, xo, 7, *got)
+    point_candidates(x, xo, 7, *got)
     for t, i in np.ndindex(3, 5):
         want = [np.empty(cand, a.dtype) for a in got]
         _nearest(x[t, i, 0], x[t, i, 1], xo, 7, *want)

@@ -18,9 +18,8 @@ from collections import namedtuple
 import numpy as np
 
 from .fused import AVAILABLE
+from .fused_search import NO_WEIGHT
 from .geometry import PAD_DIST2
-
-NO_WEIGHT = -1e30  # log φ of a padded candidate: weight exp(−1e30) = 0 (finite: fastmath)
 
 Net = namedtuple(
     "Net",
@@ -53,6 +52,7 @@ if AVAILABLE:
     from .fused_net_backward import _backward_tile
     from .fused_net_distances import readout as _distance_readout
     from .fused_net_distances import soft_min, tile_distances
+    from .fused_search import point_candidates, softmax_groups
     from .gemm import mm
 
     @_jit
@@ -81,49 +81,6 @@ if AVAILABLE:
             lphi[c] = np.log(max(near[real - 1] - near[c], 1e-12)) if c < real else NO_WEIGHT
 
     @_jit
-    def _point_candidates(x, partners, offset, idx, near, lphi):
-        """idx, near, lphi (T, N_r, C) of the tile's points x (T, N_r, 2), each among partners
-        (M, 2), as :func:`_nearest` gives them: the C smallest (d², row) in that order, point
-        parallel: partner by partner, one compare-and-swap pass per candidate slot over all
-        the tile's points (a loop the compiler vectorises; :func:`_nearest`'s insertion
-        branches on every point)."""
-        t_n, n_r, _ = x.shape
-        cand, p = idx.shape[2], t_n * n_r
-        real = min(cand, partners.shape[0])
-        px, py = np.empty(p, x.dtype), np.empty(p, x.dtype)
-        for t in range(t_n):
-            for i in range(n_r):
-                px[t * n_r + i], py[t * n_r + i] = x[t, i, 0], x[t, i, 1]
-        best = np.empty((real, p), x.dtype)  # ascending d² of each point's candidates so far
-        which = np.zeros((real, p), np.int32)  # their partner rows (int32: wider vectors)
-        best[:] = PAD_DIST2
-        dd, jj = np.empty(p, x.dtype), np.empty(p, np.int32)  # the value moving down the slots
-        for j in range(partners.shape[0]):
-            o0, o1 = partners[j, 0], partners[j, 1]
-            for q in range(p):
-                dx, dy = px[q] - o0, py[q] - o1
-                dd[q] = dx * dx + dy * dy
-                jj[q] = j
-            for c in range(real):
-                bc, wc = best[c], which[c]
-                for q in range(p):
-                    old, row, new, new_row = bc[q], wc[q], dd[q], jj[q]
-                    swap = (new < old) | ((new == old) & (new_row < row))  # by (d², row)
-                    bc[q] = new if swap else old
-                    wc[q] = new_row if swap else row
-                    dd[q] = old if swap else new
-                    jj[q] = row if swap else new_row
-        for t in range(t_n):
-            for i in range(n_r):
-                q = t * n_r + i
-                for c in range(cand):
-                    if c < real:
-                        near[t, i, c], idx[t, i, c] = best[c, q], offset + which[c, q]
-                        lphi[t, i, c] = np.log(max(best[real - 1, q] - best[c, q], 1e-12))
-                    else:
-                        near[t, i, c], idx[t, i, c], lphi[t, i, c] = PAD_DIST2, offset, NO_WEIGHT
-
-    @_jit
     def _candidates(x, net, st):
         """st.xu ← the tile's union coordinates; st.idx, near, lphi ← every row's candidates:
         robot rows among the obstacle nodes (one-way: their index; two-way: their union row),
@@ -135,8 +92,8 @@ if AVAILABLE:
             for i in range(n):
                 for j in range(2):
                     st.xu[t, i, j] = x[t, i, j] if i < n_r else net.xo[i - n_r, j]
-        _point_candidates(x, net.xo, offset, st.idx[:t_n, :n_r], st.near[:t_n, :n_r],
-                          st.lphi[:t_n, :n_r])  # fmt: skip
+        point_candidates(x, net.xo, offset, st.idx[:t_n, :n_r], st.near[:t_n, :n_r],
+                         st.lphi[:t_n, :n_r])  # fmt: skip
         for t in range(t_n):
             for i in range(n_r, n):
                 p0, p1 = st.xu[t, i, 0], st.xu[t, i, 1]
@@ -145,8 +102,7 @@ if AVAILABLE:
     @_jit
     def _soft_weights(net, st, k, t_n, two_way):
         """st.w[k] ← softmax_c (log φ − d²/τ_k + s_k,j): s the partners' readout scores of
-        layer k − 1 (two-way, k ≥ 1) or the scene's (one-way). The logits row by row, then the
-        softmax's passes over all the tile's candidates at once (the exponentials vectorise)."""
+        layer k − 1 (two-way, k ≥ 1) or the scene's (one-way)."""
         n, cand = st.idx.shape[1], st.idx.shape[2]
         zero = net.scale * 0  # in the tile's dtype
         w3 = st.w[k]
@@ -159,21 +115,7 @@ if AVAILABLE:
                     else:
                         s = net.score[k, j]
                     w3[t, i, c] = st.lphi[t, i, c] - st.near[t, i, c] / net.tau[k] + s
-        w = w3.reshape(-1)[: t_n * n * cand]
-        for r in range(0, w.shape[0], cand):  # the nearest candidate is never padded
-            top = w[r]
-            for c in range(1, cand):
-                top = max(top, w[r + c])
-            for c in range(cand):
-                w[r + c] -= top
-        for q in range(w.shape[0]):
-            w[q] = np.exp(w[q])
-        for r in range(0, w.shape[0], cand):
-            total = w[r]
-            for c in range(1, cand):
-                total += w[r + c]
-            for c in range(cand):
-                w[r + c] /= total
+        softmax_groups(w3.reshape(-1)[: t_n * n * cand], cand)
 
     @_jit
     def _node_terms(net, st, k, t_n, two_way):

@@ -136,7 +136,6 @@ def pack(
     whs, wls, ahs = torch.stack(wh), torch.stack(wl), torch.stack(ah)
     arrays = _kernels.Weights(
         feats.x0[0][real],
-        feats.x0[0][real].T,
         net.log_tau.exp(),
         torch.stack(score),
         torch.stack(v),

@@ -21,14 +21,13 @@ from ..graphdistnet.fused import AVAILABLE
 
 class Weights(NamedTuple):
     """The network and one scene's constants as contiguous arrays of one dtype (M obstacle
-    nodes): xo (M, 3) and xot (3, M), tau (K,), score (K, M) (zeros at k = 0), v (K, M, P),
+    nodes): xo (M, 3), tau (K,), score (K, M) (zeros at k = 0), v (K, M, P),
     ax (K, 3, 2P), ah (K, H, 2P) (zeros at k = 0) and aht (K, 2P, H), b1 (K, P),
     wht / wh (K, L, P, P) (transposed / not), bh (K, L, P), wlt (K, P, H) / wl (K, H, P),
     bl (K, H), att (K, H), h0t (H, R) / h0 (R, H), hb0 (R,), hwt / hw (Lr, R, R), hb (Lr, R),
     wlast (R,), blast (1,)."""
 
     xo: np.ndarray
-    xot: np.ndarray
     tau: np.ndarray
     score: np.ndarray
     v: np.ndarray
@@ -82,41 +81,10 @@ class State(NamedTuple):
 
 
 if AVAILABLE:
-    from ..graphdistnet.fused import _jit, _leaky_rows, _softmax_inplace
+    from ..graphdistnet.fused import _jit, _leaky_rows
+    from ..graphdistnet.fused_search import point_candidates, softmax_groups
     from ..graphdistnet.gemm import mm
     from .fused3d_backward import _backward_tile
-
-    @_jit
-    def _candidates(x, xot, cand, idx, near, lphi):
-        """idx, near (T, n, C): the C nearest obstacle nodes (xot (3, M)) of every x (T, n, 3),
-        ascending d² (all d² of a node first, vectorised; then an insertion sort);
-        lphi = log max(d²_C − d², 1e-12)."""
-        t_n, n, _ = x.shape
-        m = xot.shape[1]
-        dd = np.empty(m, x.dtype)
-        for t in range(t_n):
-            for i in range(n):
-                x0, x1, x2 = x[t, i, 0], x[t, i, 1], x[t, i, 2]
-                for j in range(m):
-                    dx, dy, dz = x0 - xot[0, j], x1 - xot[1, j], x2 - xot[2, j]
-                    dd[j] = dx * dx + dy * dy + dz * dz
-                for c in range(cand):
-                    near[t, i, c] = np.inf
-                    idx[t, i, c] = 0
-                worst = near[t, i, cand - 1]
-                for j in range(m):
-                    d = dd[j]
-                    if d < worst:
-                        c = cand - 1
-                        while c > 0 and near[t, i, c - 1] > d:
-                            near[t, i, c] = near[t, i, c - 1]
-                            idx[t, i, c] = idx[t, i, c - 1]
-                            c -= 1
-                        near[t, i, c] = d
-                        idx[t, i, c] = j
-                        worst = near[t, i, cand - 1]
-                for c in range(cand):
-                    lphi[t, i, c] = np.log(max(near[t, i, cand - 1] - near[t, i, c], 1e-12))
 
     @_jit
     def _soft_weights(k, t_n, wts, st):
@@ -129,7 +97,7 @@ if AVAILABLE:
                 for c in range(cand):
                     lg = st.lphi[t, i, c] - st.near[t, i, c] / wts.tau[k]
                     w[t, i, c] = lg + wts.score[k, st.idx[t, i, c]]
-                _softmax_inplace(w[t, i])
+        softmax_groups(w.reshape(-1)[: t_n * n * cand], cand)
 
     @_jit
     def _readout(k, hk, wts, st, pooled, slope):
@@ -176,7 +144,7 @@ if AVAILABLE:
         n_e = graph.src.shape[0]
         per = n_e + n  # edge rows per configuration
         rows, e_rows = t_n * n, t_n * per
-        _candidates(x, wts.xot, st.idx.shape[2], st.idx, st.near, st.lphi)
+        point_candidates(x, wts.xo, 0, st.idx, st.near, st.lphi)
         pooled = np.empty((t_n, h), x.dtype)
         nomask = np.empty((0, p), np.bool_)
         for k in range(layers):
