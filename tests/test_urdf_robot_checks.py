@@ -300,3 +300,18 @@ def test_any_mutated_collision_number_loads_every_collision_or_is_refused(
         assert "\n" not in str(e) and "mutant.urdf" in str(e)
         return
     assert shapes == xml_collisions(path) == 5
+
+
+@pytest.mark.parametrize(("bad", "match"), [("1 1 nan", "NaN or infinite"), ("1 1 5000", "1000 m")])
+def test_a_problem_file_mesh_with_a_bad_vertex_is_refused_quietly(tmp_path, capfd, bad, match):
+    from gdnplan.arm3d.shape_file3d import posed_shape
+    from gdnplan.errors import ProblemFileError
+
+    cube_obj(tmp_path / "rock.obj", bad)
+    table = {"type": "mesh", "file": "rock.obj", "position": [0.5, 0.0, 0.2]}
+    with pytest.raises(ProblemFileError, match=f"rock.obj.*{match}") as info:
+        posed_shape(table, "[[scene3d.obstacles]] 0", tmp_path, "mesh0")
+    assert "\n" not in str(info.value) and capfd.readouterr().err == ""
+    cube_obj(tmp_path / "cube.obj")
+    good = posed_shape({**table, "file": "cube.obj"}, "[[scene3d.obstacles]] 0", tmp_path, "m")
+    assert good.name == "m"

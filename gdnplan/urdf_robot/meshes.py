@@ -1,4 +1,5 @@
-"""Checks of a URDF's collision mesh files before Pinocchio loads them.
+"""Checks of mesh files before Pinocchio or coal compute with them: a URDF's collision
+meshes (:func:`check_meshes`) and any mesh file (:func:`check_mesh_file`).
 
 Each ``<mesh filename>`` is resolved as Pinocchio resolves it (``package://`` and relative
 paths against the package folders, then ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH``/share;
@@ -61,10 +62,13 @@ def check_meshes(root: ET.Element, path: Path, package_dirs: Sequence[str]) -> N
         except InputError as e:
             raise InputError(f"{where}: {e}") from e
         scale = numbers(mesh.get("scale", "1 1 1"), 3, f"{where} scale")
-        _check_mesh_file(found, scale, where)
+        check_mesh_file(found, scale, where)
 
 
-def _check_mesh_file(found: Path | None, scale: list[float], where: str) -> None:
+def check_mesh_file(found: Path | None, scale: Sequence[float], where: str) -> None:
+    """InputError "<where>: …" unless ``found`` is a regular mesh file with at least one
+    vertex, every vertex finite and, times ``scale`` (3 factors), within ``MAX_OFFSET`` m.
+    Nothing computes with the vertices before they pass (no "eigen: …" noise on stderr)."""
     if found is None or not found.exists():
         raise InputError(f"{where}: the file does not exist (searched the package folders)")
     if found.is_dir():
@@ -84,7 +88,7 @@ def _check_mesh_file(found: Path | None, scale: list[float], where: str) -> None
         )
 
 
-def _read_vertices(found: Path, scale: list[float], where: str) -> np.ndarray:
+def _read_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarray:
     """(k, 3) scaled vertices of a mesh file read by coal's assimp loader (no computation)."""
     import coal
 
