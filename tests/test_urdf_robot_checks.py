@@ -315,3 +315,13 @@ def test_a_problem_file_mesh_with_a_bad_vertex_is_refused_quietly(tmp_path, capf
     cube_obj(tmp_path / "cube.obj")
     good = posed_shape({**table, "file": "cube.obj"}, "[[scene3d.obstacles]] 0", tmp_path, "m")
     assert good.name == "m"
+
+
+@KINDS
+def test_a_urdf_with_visuals_only_is_refused_saying_visuals_are_not_read(tmp_path, kind):
+    text = re.sub(r"<collision>.*?</collision>", "", TEXT, flags=re.S)
+    visual = '<visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>'
+    path = tmp_path / "visual_only.urdf"
+    path.write_text(text.replace('<link name="forearm">', f'<link name="forearm">{visual}'))
+    assert xml_collisions(path) == 0
+    refused(path, kind, r"no collision geometry.*<visual> elements are not read")

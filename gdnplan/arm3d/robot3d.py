@@ -205,7 +205,10 @@ def robot3d_from_urdf(
     reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
     shapes = [_link_shape(reduced, obj) for obj in reduced_geom.geometryObjects]
     if not shapes:
-        raise InputError(f"urdf: {path.name} has no collision geometry; add <collision> shapes")
+        raise InputError(
+            f"urdf: {path.name} has no collision geometry (<visual> elements are not read); "
+            "add <collision> shapes"
+        )
     pairs, disabled = self_collision_pairs(model, reduced, shapes, srdf)
     return Robot3D(name or path.stem, reduced, shapes, pairs, disabled, {"urdf": str(path)})
 

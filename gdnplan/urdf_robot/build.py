@@ -108,8 +108,9 @@ def robot_from_models(
         polygons.append(_attach(reduced, data, plane, pname, frame, np.asarray(uv, float)))
     if not polygons:
         raise InputError(
-            f"{name}: {source} has no collision geometry to project and no polygons were "
-            "given; add <collision> shapes to its links or give link polygons"
+            f"{name}: {source} has no collision geometry to project (<visual> elements are "
+            "not read) and no polygons were given; add <collision> shapes to its links or "
+            "give link polygons"
         )
 
     lower = reduced.lowerPositionLimit.copy() if limits is None else np.asarray(limits[0], float)
