@@ -33,6 +33,15 @@ from ..errors import InputError
 from ..geometry import pad_polygons
 from ..scene import Scene, make_scene
 from .checks import build_net, card_config, check_count, check_fits, check_layout
+from .fields import (
+    MAX_LENGTH,
+    MIN_LENGTH,
+    check_choice,
+    check_int,
+    check_real,
+    check_widths,
+    shown,
+)
 from .threads import check_threads, torch_threads
 from .weights import card_path, read_weights, write_weights
 
@@ -53,6 +62,10 @@ class ClearanceNetConfig:
         hidden: widths of the hidden layers.
         dropout: dropout probability after each hidden layer (0 = none).
         scale: output scale (m): the network predicts d / scale (the robot's reach).
+
+    Every field is checked when a config is made (a card, :meth:`for_env`): counts in
+    1 … :data:`LIMITS`, widths as :func:`.fields.check_widths`, ``dropout`` in [0, 0.99],
+    ``scale`` in [1e-3, 1e3] m; InputError naming the field.
     """
 
     env: str
@@ -80,27 +93,39 @@ class ClearanceNetConfig:
         )
         return ClearanceNetConfig(**{**asdict(base), **changes})
 
+    def __post_init__(self) -> None:
+        """Check every field's type and range (:data:`LIMITS`, :mod:`.fields`; InputError
+        naming the field) and store ``hidden`` as a tuple, ``dropout`` and ``scale`` as floats."""
+        for name, value in _checked(self).items():
+            object.__setattr__(self, name, value)
+
     @classmethod
     def from_dict(cls, data: dict) -> ClearanceNetConfig:
         """The config of a card (``hidden`` a list there); InputError on bad fields."""
-        config = cls(**{**data, "hidden": tuple(data.get("hidden", cls.hidden))})
-        ints = (config.dof, config.n_obstacles, config.n_vertices, *config.hidden)
-        if not all(isinstance(v, int) and not isinstance(v, bool) and v >= 1 for v in ints):
-            raise InputError(
-                "ClearanceNet config: dof, n_obstacles, n_vertices, hidden must be ≥ 1"
-            )
-        if config.encoding not in ("pose", "vertices") or not isinstance(config.env, str):
-            raise InputError(f"ClearanceNet config: unknown encoding {config.encoding!r}")
-        if not (isinstance(config.dropout, (int, float)) and 0 <= config.dropout < 1):
-            raise InputError(f"ClearanceNet config: dropout in [0, 1), got {config.dropout!r}")
-        if not (isinstance(config.scale, (int, float)) and 0 < config.scale < math.inf):
-            raise InputError(f"ClearanceNet config: scale must be positive, got {config.scale!r}")
-        return config
+        return cls(**data)
 
     @property
     def n_features(self) -> int:
         per = 4 if self.encoding == "pose" else 2 * self.n_vertices
         return self.dof + self.n_obstacles * per
+
+
+# Ranges of the config's counts (the widths: :mod:`.fields`, MAX_WIDTH and MAX_DEPTH).
+LIMITS = {"dof": 64, "n_obstacles": 1024, "n_vertices": 1024}
+
+
+def _checked(c: ClearanceNetConfig) -> dict:
+    """The fields of ``c`` checked: counts in 1 … :data:`LIMITS`, ``encoding`` pose or
+    vertices, ``dropout`` in [0, 0.99], ``scale`` in [1e-3, 1e3] m (float32-safe)."""
+    if not isinstance(c.env, str) or not 0 < len(c.env) <= 64:
+        raise InputError(f"env: expected an environment name, got {shown(c.env)}")
+    counts = {k: check_int(k, getattr(c, k), 1, high) for k, high in LIMITS.items()}
+    return counts | {
+        "encoding": check_choice("encoding", c.encoding, ("pose", "vertices")),
+        "hidden": check_widths("hidden", c.hidden),
+        "dropout": check_real("dropout", c.dropout, 0.0, 0.99),
+        "scale": check_real("scale", c.scale, MIN_LENGTH, MAX_LENGTH, " m"),
+    }
 
 
 def obstacle_vector(config: ClearanceNetConfig, polygons: np.ndarray, sizes: np.ndarray):

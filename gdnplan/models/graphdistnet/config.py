@@ -5,16 +5,36 @@ The loss and schedule of its training are training settings (:mod:`gdnplan.train
 their flat ``config``; :meth:`GraphDistNetConfig.from_dict` skips them (``LOSS_KEYS``), and
 ``gdnplan.train.split_config`` reads them as the loss. Options that were removed
 (``REMOVED``) load at their former default value and are refused at any other.
+
+Every field is checked for its type and range when a config is made (from a card, a preset
+or ``with_``): InputError naming the field (:mod:`gdnplan.models.fields` has the rules and
+bounds). The ranges: ``layers`` 1 … 64; ``hidden`` and every width of ``mlp`` / ``readout``
+1 … 4096, at most 16 widths each; ``cross_k`` 1 … 64; ``probe_split`` 1 … 32; ``tau`` and
+``tau_min`` in [1e-12, 1e6]; ``scale`` and ``correction_band`` in [1e-3, 1e3] m; ``origin``
+two numbers of magnitude ≤ 1e3 m; flags true / false only.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, fields, replace
 
-import numpy as np
-
 from ...errors import InputError
+from ..fields import (
+    MAX_CROSS_K,
+    MAX_LAYERS,
+    MAX_LENGTH,
+    MAX_PROBE_SPLIT,
+    MAX_TEMPERATURE,
+    MAX_WIDTH,
+    MIN_LENGTH,
+    MIN_TEMPERATURE,
+    check_choice,
+    check_flag,
+    check_int,
+    check_point,
+    check_real,
+    check_widths,
+)
 
 
 @dataclass(frozen=True)
@@ -50,8 +70,10 @@ class GraphDistNetConfig:
             (1 − g) · m), g = σ(8 (1 − scale · m / β)): the MLP's estimate in overlap and
             near contact, m beyond ≈ 2β (None: the residual m + MLP everywhere). Needs
             ``min_readout``.
-        scale: metres per normalised unit (the robot's reach); d̂ = scale · net output.
-        origin: (x, y) subtracted from coordinates before scaling (joint 1, m).
+        scale: metres per normalised unit (the robot's reach); d̂ = scale · net output
+            (1e-3 … 1e3 m: coordinates stay float32-safe).
+        origin: (x, y) subtracted from coordinates before scaling (joint 1, m; each
+            coordinate of magnitude ≤ 1e3 m).
     """
 
     layers: int = 4
@@ -71,21 +93,15 @@ class GraphDistNetConfig:
     origin: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if any(isinstance(v, float) and not math.isfinite(v) for v in np.ravel(value)):
-                raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
-        if self.cross not in ("argmax", "soft_knn"):
-            raise InputError(f"cross: expected 'argmax' or 'soft_knn', got {self.cross!r}")
-        if self.layers < 1 or self.hidden < 1 or self.cross_k < 1 or self.scale <= 0:
-            raise InputError("layers, hidden, cross_k and scale must be positive")
+        """Check every field's type and range (:mod:`gdnplan.models.fields`; InputError naming
+        the field) and store lists as tuples, numbers of real fields as floats."""
+        for name, value in _checked(self).items():
+            object.__setattr__(self, name, value)
         if self.min_readout and not self.node_distance:
             raise InputError("min_readout needs node_distance=True (it reads the node distances)")
-        if self.tau_min <= 0:
-            raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
-        if self.correction_band is not None and (self.correction_band <= 0 or not self.min_readout):
+        if self.correction_band is not None and not self.min_readout:
             raise InputError("correction_band must be a positive length (m) and needs min_readout")
-        if self.probe_split < 1 or (self.probe_split > 1 and not self.min_readout):
+        if self.probe_split > 1 and not self.min_readout:
             raise InputError("probe_split must be ≥ 1, and > 1 needs min_readout")
 
     @classmethod
@@ -127,9 +143,6 @@ class GraphDistNetConfig:
         unknown = set(data) - known
         if unknown:
             raise InputError(f"config: unknown GraphDistNet options {sorted(unknown)}")
-        for key in ("mlp", "readout", "origin"):
-            if key in data:
-                data[key] = tuple(data[key])
         return cls(**data)
 
     def with_(self, **changes) -> GraphDistNetConfig:
@@ -141,6 +154,30 @@ class GraphDistNetConfig:
                 "gdnplan.train.GraphDistNetLoss"
             )
         return replace(self, **changes)
+
+
+def _checked(c: GraphDistNetConfig) -> dict:
+    """The fields of ``c`` checked (bounds: :mod:`gdnplan.models.fields`)."""
+    band = c.correction_band
+    return {
+        "layers": check_int("layers", c.layers, 1, MAX_LAYERS),
+        "hidden": check_int("hidden", c.hidden, 1, MAX_WIDTH),
+        "mlp": check_widths("mlp", c.mlp),
+        "readout": check_widths("readout", c.readout),
+        "cross": check_choice("cross", c.cross, ("argmax", "soft_knn")),
+        "cross_k": check_int("cross_k", c.cross_k, 1, MAX_CROSS_K),
+        "two_way": check_flag("two_way", c.two_way),
+        "tau": check_real("tau", c.tau, MIN_TEMPERATURE, MAX_TEMPERATURE),
+        "node_distance": check_flag("node_distance", c.node_distance),
+        "min_readout": check_flag("min_readout", c.min_readout),
+        "tau_min": check_real("tau_min", c.tau_min, MIN_TEMPERATURE, MAX_TEMPERATURE),
+        "probe_split": check_int("probe_split", c.probe_split, 1, MAX_PROBE_SPLIT),
+        "correction_band": None
+        if band is None
+        else check_real("correction_band", band, MIN_LENGTH, MAX_LENGTH, " m"),
+        "scale": check_real("scale", c.scale, MIN_LENGTH, MAX_LENGTH, " m"),
+        "origin": check_point("origin", c.origin, 2),
+    }
 
 
 # Loss weights that old flat cards keep in their config (training settings now).

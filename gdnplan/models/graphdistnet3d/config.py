@@ -1,13 +1,34 @@
-"""GraphDistNet-3D's architecture :class:`GraphDistNet3DConfig` and its dict form."""
+"""GraphDistNet-3D's architecture :class:`GraphDistNet3DConfig` and its dict form.
+
+Every field is checked for its type and range when a config is made (a card, code,
+``with_``): InputError naming the field (:mod:`gdnplan.models.fields` has the rules and
+bounds). The ranges: ``layers`` 1 … 64; ``hidden`` and every width of ``mlp`` / ``readout``
+1 … 4096, at most 16 widths each; ``cross_k`` 1 … 64; ``rim`` 3 … 64 points; ``tau`` and
+``tau_min`` in [1e-12, 1e6]; ``length`` and ``scale`` in [1e-3, 1e3] m; ``origin`` three
+numbers of magnitude ≤ 1e3 m; ``min_readout`` true / false only.
+"""
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, fields, replace
 
-import numpy as np
-
 from ...errors import InputError
+from ..fields import (
+    MAX_CROSS_K,
+    MAX_LAYERS,
+    MAX_LENGTH,
+    MAX_TEMPERATURE,
+    MAX_WIDTH,
+    MIN_LENGTH,
+    MIN_TEMPERATURE,
+    check_flag,
+    check_int,
+    check_point,
+    check_real,
+    check_widths,
+)
+
+MAX_RIM = 64  # points per cylinder rim of the robot graph
 
 
 @dataclass(frozen=True)
@@ -47,20 +68,10 @@ class GraphDistNet3DConfig:
     tau_min: float = 0.05
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if any(isinstance(v, float) and not math.isfinite(v) for v in np.ravel(value)):
-                raise InputError(f"{f.name}: expected finite numbers, got {value!r}")
-        if min(self.layers, self.hidden, self.cross_k) < 1 or min(self.scale, self.tau) <= 0:
-            raise InputError("layers, hidden, cross_k, tau and scale must be positive")
-        if self.tau_min <= 0:
-            raise InputError(f"tau_min: expected a positive temperature, got {self.tau_min}")
-        if self.length <= 0:
-            raise InputError(f"length: expected a positive length (m), got {self.length}")
-        if len(self.origin) != 3:
-            raise InputError(f"origin: expected (x, y, z), got {self.origin!r}")
-        if self.rim < 3:
-            raise InputError(f"rim: expected at least 3 points per rim, got {self.rim}")
+        """Check every field's type and range (module docstring; InputError naming the field)
+        and store lists as tuples, numbers of real fields as floats."""
+        for name, value in _checked(self).items():
+            object.__setattr__(self, name, value)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -71,11 +82,25 @@ class GraphDistNet3DConfig:
         unknown = set(data) - known
         if unknown:
             raise InputError(f"config: unknown GraphDistNet-3D options {sorted(unknown)}")
-        data = dict(data)
-        for key in ("mlp", "readout", "origin"):
-            if key in data:
-                data[key] = tuple(data[key])
-        return cls(**data)
+        return cls(**dict(data))
 
     def with_(self, **changes) -> GraphDistNet3DConfig:
         return replace(self, **changes)
+
+
+def _checked(c: GraphDistNet3DConfig) -> dict:
+    """The fields of ``c`` checked (bounds: :mod:`gdnplan.models.fields`)."""
+    return {
+        "layers": check_int("layers", c.layers, 1, MAX_LAYERS),
+        "hidden": check_int("hidden", c.hidden, 1, MAX_WIDTH),
+        "mlp": check_widths("mlp", c.mlp),
+        "readout": check_widths("readout", c.readout),
+        "cross_k": check_int("cross_k", c.cross_k, 1, MAX_CROSS_K),
+        "tau": check_real("tau", c.tau, MIN_TEMPERATURE, MAX_TEMPERATURE),
+        "length": check_real("length", c.length, MIN_LENGTH, MAX_LENGTH, " m"),
+        "scale": check_real("scale", c.scale, MIN_LENGTH, MAX_LENGTH, " m"),
+        "origin": check_point("origin", c.origin, 3),
+        "rim": check_int("rim", c.rim, 3, MAX_RIM),
+        "min_readout": check_flag("min_readout", c.min_readout),
+        "tau_min": check_real("tau_min", c.tau_min, MIN_TEMPERATURE, MAX_TEMPERATURE),
+    }

@@ -10,6 +10,8 @@ from pathlib import Path
 import torch
 
 from ...errors import InputError
+from ..checks import build_net, card_config, check_count
+from ..threads import check_threads
 from ..weights import read_weights
 from .config import GraphDistNet3DConfig
 from .model import GraphDistNet3DModel
@@ -27,11 +29,17 @@ def read_graphdistnet3d(path: Path | str) -> tuple[dict[str, torch.Tensor], dict
 def load_graphdistnet3d(
     path: Path | str, threads: int | None = None, fused: bool | None = None
 ) -> GraphDistNet3DModel:
-    """The DistanceModel of a weights file (InputError for a card of another model); ``fused``
-    as in :class:`GraphDistNet3DModel`."""
+    """The DistanceModel of a weights file (InputError for a card of another model, a config
+    field of the wrong type or range, or tensors that do not fit the config's network, all
+    before anything runs); ``fused`` as in :class:`GraphDistNet3DModel`."""
+    threads = check_threads(threads)
+    path = Path(path)
     tensors, card = read_graphdistnet3d(path)
-    net = GraphDistNet3D(GraphDistNet3DConfig.from_dict(card["config"]))
-    net.load_state_dict(tensors)
+    config = card_config(path, card, "GraphDistNet-3D", GraphDistNet3DConfig.from_dict)
+    for name, depth in (("layers", config.layers), ("mlp", len(config.mlp) or 1)):
+        check_count(depth, len(tensors), name, path)  # else a huge network before the check
+    check_count(len(config.readout) or 1, len(tensors), "readout", path)
+    net = build_net(path, "GraphDistNet-3D", lambda: GraphDistNet3D(config), tensors)
     return GraphDistNet3DModel(net, card, threads=threads, fused=fused)
 
 
@@ -42,7 +50,7 @@ def init_from_weights(net: GraphDistNet3D, path: Path | str) -> list[str]:
     tensor ``net`` lacks or of another shape, or an architecture whose normalisation (scale,
     length, origin) differs from ``net``'s: the copied function would not be the file's."""
     tensors, card = read_graphdistnet3d(path)
-    theirs = GraphDistNet3DConfig.from_dict(card["config"])
+    theirs = card_config(Path(path), card, "GraphDistNet-3D", GraphDistNet3DConfig.from_dict)
     ours = net.config
     for key in ("scale", "length", "origin", "rim"):
         if getattr(theirs, key) != getattr(ours, key):
