@@ -61,9 +61,24 @@ def _check_ref(ref, what: str) -> None:
         )
 
 
+def is_file(path: Path | str, what: str, ref: object = None) -> bool:
+    """``Path(path).is_file()``, with any OSError while looking (a name longer than the file
+    system allows, a folder without permission) an InputError naming the argument ``what``
+    and the reference ``ref`` it came from (default: ``path``), cut to one short line."""
+    try:
+        return Path(path).is_file()
+    except OSError as e:
+        text = str(path if ref is None else ref)
+        cut = text if len(text) <= 60 else f"{text[:60]}… ({len(text)} characters)"
+        raise InputError(
+            f"{what}: cannot look up {cut!r} ({e.strerror or type(e).__name__}); give a shipped "
+            f"{what} name or the path of an existing file"
+        ) from e
+
+
 def _shipped(ref: str, folder: Path, suffix: str, what: str, names: list[str]) -> Path:
     path = folder / f"{ref}{suffix}"
-    if not path.is_file():
+    if not is_file(path, what, ref):
         raise UnknownNameError(
             f"{what}: no shipped {what} named {ref!r}; choose one of {names} or give a path"
         )
@@ -74,7 +89,7 @@ def problem_file(ref: str | Path) -> Path:
     """The problem file ``ref`` names: a path as given (or an existing file), or a shipped
     problem by name (``"fetch_reach"``; see :func:`problem_names`)."""
     _check_ref(ref, "problem")
-    if looks_like_path(ref) or Path(ref).is_file():
+    if looks_like_path(ref) or is_file(ref, "problem"):
         return Path(ref)
     return _shipped(str(ref), PROBLEMS_DIR, ".toml", "problem", problem_names())
 

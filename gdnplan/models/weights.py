@@ -27,6 +27,7 @@ from pathlib import Path
 import torch
 from safetensors.torch import save_file
 
+from ..assets import is_file
 from ..errors import InputError
 from ..files import atomic_path, write_text
 from .checks import load_tensors, parse_card
@@ -62,9 +63,12 @@ def check_pair(path: Path | str, card: dict, what: str = "weights") -> None:
             f"describe {path.name}; {fix}, or, after checking the pair, run "
             f"`python -m gdnplan.models.weights seal {path}`"
         )
-    if not path.exists():
+    if not is_file(path, what):
         raise InputError(f"{what}: {path} not found (its card {name} is there)")
-    actual = file_sha256(path)
+    try:
+        actual = file_sha256(path)
+    except OSError as e:
+        raise InputError(f"{what}: cannot read {path} ({e.strerror or e})") from e
     if actual != recorded:
         raise InputError(
             f"{what}: card {name} does not belong to {path.name} (it records tensors "
@@ -76,12 +80,12 @@ def check_pair(path: Path | str, card: dict, what: str = "weights") -> None:
 def read_card(path: Path | str, what: str = "weights") -> dict:
     """The JSON card of the weights ``path``, checked against the tensors file (module
     docstring); InputError (prefixed by ``what``) when missing or not the pair's card."""
-    if not Path(path).is_file():
+    if not is_file(path, what):
         raise InputError(
             f"{what}: {path} does not exist or is not a file (give a .safetensors file or a name)"
         )
     card = card_path(path)
-    if not card.exists():
+    if not is_file(card, what):
         raise InputError(f"{what}: no card {card.name} beside {path}")
     content = parse_card(card, what)
     check_pair(path, content, what)
@@ -92,8 +96,8 @@ def read_weights(path: Path | str, what: str = "weights") -> tuple[dict[str, tor
     """Tensors and card of the weights ``path``; InputError when either file is missing or
     they are not a pair."""
     path = Path(path)
-    if not path.exists():
-        raise InputError(f"{what}: {path} not found")
+    if not is_file(path, what):
+        raise InputError(f"{what}: {path} not found (or not a file)")
     card = read_card(path, what)
     return load_tensors(path, what), card
 
