@@ -145,3 +145,18 @@ def test_a_non_convex_mesh_becomes_its_hull_with_a_logged_note(tmp_path, caplog)
     # the hull is the full cube: a sphere above the dent is as far as from the cube's top
     d = coal_distance(obs.shape, obs.pose, coal.Sphere(0.05), as_pose((0, 0, 0.3)))
     assert d == pytest.approx(0.3 - 0.1 - 0.05, abs=1e-6)
+
+
+@pytest.mark.parametrize("bad", ["nan 1 1", "1 inf 1", "1e9 1 1"])
+def test_load_mesh_refuses_bad_vertices_before_computing_with_them(tmp_path, capfd, bad):
+    """A NaN, infinite or far vertex: InputError naming the vertex or the distance, and no
+    "eigen: too many iterations" lines on stderr (nothing computed with it first)."""
+    corners = [f"{x} {y} {z}" for x in (0, 1) for y in (0, 1) for z in (0, 1)][:-1]
+    faces = ["1 2 3", "2 3 4", "5 6 7", "6 7 8", "1 2 5", "2 5 6", "3 4 7", "4 7 8"]
+    path = tmp_path / "cube.obj"
+    path.write_text(
+        "".join(f"v {c}\n" for c in [*corners, bad]) + "".join(f"f {f}\n" for f in faces)
+    )
+    with pytest.raises(InputError, match=r"NaN or infinite|beyond"):
+        load_mesh(path, name="part")
+    assert "eigen" not in capfd.readouterr().err

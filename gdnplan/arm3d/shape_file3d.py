@@ -15,9 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GdnplanError, ProblemFileError
-from ..limits import is_number
 from ..scene import no_unknown_keys
-from ..urdf_robot.meshes import check_mesh_file
 from .cloud3d import DEFAULT_RESOLUTION, cloud_obstacle, read_cloud
 from .scene3d import (
     Obstacle3D,
@@ -125,9 +123,7 @@ def posed_shape(
         if kind == "cloud":
             return _cloud(table, where, base_dir, position, rotation, name)
         path = file_path(table["file"], base_dir, f"{where} file")
-        scale = table.get("scale", [1, 1, 1])
-        _quiet_mesh_check(path, scale)
-        return mesh_obstacle(path, position, rotation, scale, name)
+        return mesh_obstacle(path, position, rotation, table.get("scale", [1, 1, 1]), name)
     except ProblemFileError:
         raise
     except GdnplanError as e:
@@ -148,22 +144,6 @@ def _cloud(table: dict, where: str, base_dir: Path, position, rotation, name) ->
         points = table["points"]
     resolution = table.get("resolution", DEFAULT_RESOLUTION)
     return cloud_obstacle(points, resolution, position, rotation, name)
-
-
-def _quiet_mesh_check(path: Path, scale) -> None:
-    """Read a mesh file's vertices without computing with them first (coal's loader prints
-    "eigen: too many iterations" for a NaN vertex): InputError for a file that is no mesh or
-    has NaN, infinite or far vertices. A missing file or a bad ``scale`` is left to
-    :func:`~gdnplan.arm3d.shapes.load_mesh`, which names them."""
-    factors = np.asarray(scale, dtype=object)
-    if factors.shape != (3,) or not all(is_number(f) and math.isfinite(f) and f for f in factors):
-        return
-    try:
-        found = path.is_file()
-    except (OSError, ValueError):  # a name too long, a NUL byte
-        found = False
-    if found:
-        check_mesh_file(path, [float(f) for f in factors], f"mesh file {path.name}")
 
 
 def obstacle_from_table(table, k: int, base_dir: Path) -> Obstacle3D:

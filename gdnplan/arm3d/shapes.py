@@ -31,6 +31,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from ..errors import InputError, UnknownNameError
 from ..limits import is_number
+from ..urdf_robot.meshes import mesh_vertices
 
 MAX_COORDINATE = 1e3  # m: largest |coordinate| of any point, position or size
 MIN_SIZE = 1e-6  # m: smallest primitive size and hull thickness
@@ -195,11 +196,10 @@ def load_mesh(path, scale=(1.0, 1.0, 1.0), name: str = "mesh") -> coal.ConvexBas
     factors = np.asarray(scale, dtype=float)
     if factors.shape != (3,) or not np.all(np.isfinite(factors)) or np.any(factors <= 0):
         raise InputError(f"{name}.scale: expected three positive numbers, got {scale!r}")
-    try:
-        bvh = coal.MeshLoader().load(str(path), factors)
-    except (ValueError, RuntimeError) as e:
-        raise InputError(f"{name}: {path} is not a mesh file coal can read (STL, OBJ, DAE)") from e
-    return mesh_hull(bvh_vertices(bvh), f"{name} ({path.name})")
+    # read and checked (finite, bounded) before anything computes with them: coal's own
+    # loader prints "eigen: too many iterations" for a NaN vertex
+    vertices = mesh_vertices(path, factors, f"{name}: mesh file {path.name}")
+    return mesh_hull(vertices, f"{name} ({path.name})")
 
 
 def bvh_vertices(geometry) -> np.ndarray:

@@ -66,11 +66,18 @@ def check_meshes(root: ET.Element, path: Path, package_dirs: Sequence[str]) -> N
 
 
 def check_mesh_file(found: Path | None, scale: Sequence[float], where: str) -> None:
-    """InputError "<where>: …" unless ``found`` is a regular mesh file with at least one
-    vertex, every vertex finite and, times ``scale`` (3 factors), within ``MAX_OFFSET`` m.
-    Nothing computes with the vertices before they pass (no "eigen: …" noise on stderr)."""
+    """InputError "<where>: …" unless ``found`` is a regular mesh file whose vertices pass
+    :func:`mesh_vertices`."""
     if found is None or not found.exists():
         raise InputError(f"{where}: the file does not exist (searched the package folders)")
+    mesh_vertices(found, scale, where)
+
+
+def mesh_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarray:
+    """(k, 3) vertices (m) of the mesh file ``found`` times ``scale`` (3 factors); InputError
+    "<where>: …" unless it is a regular mesh file with at least one vertex, every vertex
+    finite and within ``MAX_OFFSET`` m. Nothing computes with the vertices before they pass
+    (no "eigen: …" noise on stderr)."""
     if found.is_dir():
         raise InputError(f"{where}: {found} is a directory, not a mesh file")
     if not found.is_file():
@@ -86,6 +93,7 @@ def check_mesh_file(found: Path | None, scale: Sequence[float], where: str) -> N
             f"{where}: {found} has vertices beyond {MAX_OFFSET:g} m of the link frame "
             f"(scale {scale}); give the mesh in metres or a scale"
         )
+    return vertices
 
 
 def _read_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarray:
