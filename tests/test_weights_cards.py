@@ -203,6 +203,44 @@ def test_one_mutated_config_field_is_an_input_error_or_finite(data, src, tmp_pat
     assert_finite(model, scene_of(src))
 
 
+IN_RANGE = {  # fields that leave the tensors' shapes alone -> values of their documented range
+    "scale": st.floats(1e-3, 1e3),
+    "length": st.floats(1e-3, 1e3),
+    "origin": st.lists(st.floats(-1e3, 1e3), min_size=3, max_size=3),
+    "cross_k": st.integers(1, 64),
+    "probe_split": st.integers(1, 32),
+    "tau": st.floats(1e-12, 1e6),
+    "tau_min": st.floats(1e-12, 1e6),
+    "correction_band": st.floats(1e-3, 1e3),
+    "two_way": st.booleans(),
+    "rim": st.integers(3, 64),
+    "n_vertices": st.integers(1, 1024),
+}
+
+
+@settings(
+    max_examples=60,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data(), src=st.sampled_from(sorted(SCENES)))
+def test_one_config_field_anywhere_in_its_range_gives_finite_distances(data, src, tmp_path):
+    """A field that does not change the tensors' shapes, set anywhere in its documented range
+    (origin: the first 2 or 3 coordinates): the model loads, or is refused for a combination
+    (e.g. probe points without the soft-minimum readout), and its distances are finite."""
+    config = json.loads((WEIGHTS / f"{src}.json").read_text())["config"]
+    key = data.draw(st.sampled_from(sorted(set(config) & set(IN_RANGE))), label="key")
+    value = data.draw(IN_RANGE[key], label="value")
+    if key == "origin":
+        value = value[: len(config["origin"])]
+    try:
+        model = gp.load_model(mutated(tmp_path, src, **{key: value}))
+    except gp.InputError as e:
+        assert "needs" in str(e), e  # a combination, not the range
+        return
+    assert_finite(model, scene_of(src))
+
+
 # ------------------------------------------------------------------ names too long for the OS
 LONG = ["a" * 5000, "a" * 5000 + ".safetensors", "x/" + "a" * 300 + ".safetensors"]
 
