@@ -230,8 +230,9 @@ JSON = st.recursive(
 def test_mutated_cards_load_or_raise_gdnplan_errors(where, key, value, tmp_path):
     """Any one field of a card (or of its config) replaced by any JSON value: the weights load
     or a GdnplanError says why (never another exception; sizes are checked on the meta device,
-    so a huge network costs nothing). Inference is not run: run-time sizes such as cross_k and
-    probe_split are not bounded by the card check."""
+    so a huge network costs nothing). Inference is not run here; tests/test_weights_cards.py
+    runs it on every card that loads (run-time sizes such as cross_k and probe_split are
+    bounded by the config's checks)."""
     card = json.loads((WEIGHTS / "a.json").read_text())
     if where == "card":
         card[key] = value

@@ -269,3 +269,14 @@ def test_cli_weights_too_long_exit_2_naming_weights(ref, capsys):
     assert exit_.value.code == 2, lines
     assert len(lines) == 1 and lines[0].startswith("error: weights: "), lines
     assert "internal error" not in lines[0] and len(lines[0]) < 400
+
+
+def test_values_in_messages_stay_one_short_line():
+    from gdnplan.models.fields import shown
+
+    nested: list = []
+    for _ in range(10_000):
+        nested = [nested]
+    assert shown(10**5000) == "an integer of about 5000 digits"
+    assert shown(nested) == "a list nested too deeply to show"
+    assert shown("a" * 100) == "'" + "a" * 39 + "…"

@@ -44,6 +44,8 @@ def shown(value: object, limit: int = 40) -> str:
         text = repr(value)
     except ValueError:  # an int beyond Python's digit limit for str()
         return f"an integer of about {value.bit_length() * 0.30103:.0f} digits"
+    except RecursionError:  # lists nested deeper than repr follows
+        return f"a {type(value).__name__} nested too deeply to show"
     return text if len(text) <= limit else f"{text[:limit]}…"
 
 
