@@ -35,6 +35,41 @@ def collision_cost(
     return cost, dcost
 
 
+def project_steps(
+    q: np.ndarray, max_step: float, lower: np.ndarray, upper: np.ndarray, sweeps: int = 50
+) -> np.ndarray:
+    """q (T, dof) moved into {|q_{t+1} − q_t| ≤ max_step, lower ≤ q ≤ upper} with q_0 and
+    q_{T−1} fixed (rad). Alternating projections first: each sweep projects the even, then the
+    odd segments (disjoint, so each half is exact: a step too long is shortened symmetrically
+    about its middle, or towards a fixed end), then clips to the limits. What the sweeps leave
+    over max_step is removed by moving towards the straight line between the ends, which keeps
+    both bounds (Problem checks max_step · (T − 1) against the start-goal distance, and the
+    ends lie within the limits): q ← L + β (q − L), the largest such β ∈ [0, 1]."""
+    q = q.copy()
+    free = np.ones(len(q), bool)
+    free[[0, -1]] = False
+    for _ in range(sweeps):
+        if np.max(np.abs(np.diff(q, axis=0))) <= max_step:
+            return q
+        for first in (0, 1):
+            t = np.arange(first, len(q) - 1, 2)
+            step = q[t + 1] - q[t]
+            excess = np.sign(step) * np.maximum(np.abs(step) - max_step, 0.0)
+            a, b = free[t][:, None], free[t + 1][:, None]
+            share = np.where(a & b, 0.5, 1.0)  # both free: half each; else all to the free one
+            q[t] += np.where(a, share * excess, 0.0)
+            q[t + 1] -= np.where(b, share * excess, 0.0)
+        q[1:-1] = np.clip(q[1:-1], lower, upper)
+    line = straight_line(q[0], q[-1], len(q))
+    d, dl = np.diff(q, axis=0), np.diff(line, axis=0)
+    over = np.abs(d) > max_step
+    if not over.any():
+        return q
+    bound = np.sign(d[over]) * max_step  # the bound each long step crosses
+    beta = np.min(np.clip((bound - dl[over]) / (d[over] - dl[over]), 0.0, 1.0))
+    return line + beta * (q - line)
+
+
 def _plan_adam(
     problem: Problem,
     model: DistanceModel,
@@ -46,11 +81,13 @@ def _plan_adam(
     """Adam on the interior waypoints of Σ_k C(d(p_k)) + Σ_t ‖q_{t+1} − q_t‖², from the
     straight line, until the collision cost falls below the threshold — every term below
     C(margin + adam_stop), i.e. min_k d(p_k) ≥ margin + adam_stop as C decreases above the
-    margin — or the iteration cap. With ``ccd``, reaching the threshold triggers the continuous
-    certificate; uncertified segments get twice the check points and Adam continues. The
-    margin of each check point is that of :func:`distance_bounds` (relaxed next to an endpoint
-    a learned model rates below the margin). It stops at ``deadline`` (a
-    :func:`time.perf_counter` value) too; the certificate judges the path it has then."""
+    margin — or the iteration cap; every iterate is projected onto the step bound
+    ``max_step`` and the joint limits (:func:`project_steps`). With ``ccd``, reaching the
+    threshold triggers the continuous certificate; uncertified segments get twice the check
+    points and Adam continues. The margin of each check point is that of
+    :func:`distance_bounds` (relaxed next to an endpoint a learned model rates below the
+    margin). It stops at ``deadline`` (a :func:`time.perf_counter` value) too; the
+    certificate judges the path it has then."""
     opts, refine = cfg.optimizer, cfg.refine
     T = problem.waypoints
     splits = np.full(T - 1, opts.interpolated + 1)
@@ -85,7 +122,7 @@ def _plan_adam(
         m = b1 * m + (1 - b1) * grad
         v = b2 * v + (1 - b2) * grad**2
         step = opts.lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
-        q = np.clip(q - step, problem.lower, problem.upper)
+        q = project_steps(q - step, problem.max_step, problem.lower, problem.upper)
     log.info("solve: %s, %d iterations", status, it)
     return _Run(
         q=q,

@@ -26,13 +26,22 @@ from .check_points import (
 from .config import PlanConfig
 from .problem import Problem
 from .refine import underestimated_segments, with_exact_rows
-from .result import _Run, path_cost
+from .result import _Run, path_cost, path_violation
 from .seeds import SeedInfo, draw_seed
 from .transcription import _Transcription
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
-SOLVER_ERRORS = {"Invalid_Number_Detected", "Unrecoverable_Exception", "Internal_Error"}
+# statuses whose x is no solver iterate (or none of this problem): never accepted
+SOLVER_ERRORS = {
+    "Invalid_Number_Detected",
+    "Unrecoverable_Exception",
+    "Internal_Error",
+    "NonIpopt_Exception_Thrown",
+    "Insufficient_Memory",
+    "Invalid_Option",
+    "Invalid_Problem_Definition",
+}
 
 
 def _line_free(problem: Problem, line: np.ndarray) -> bool:
@@ -114,7 +123,8 @@ def _plan_ipopt(
         if not ok:
             failures += 1
             run.q, run.status = q, status
-            run.reason = f"{run.reason}; {label}: {status}, path not certified".lstrip("; ")
+            why = run.violation or "path not certified"
+            run.reason = f"{run.reason}; {label}: {status}, {why}".lstrip("; ")
             continue
         best.certified += 1
         cost = path_cost(q)
@@ -198,12 +208,17 @@ def _solve_refined(
         log.info("solve: Ipopt round %d: %s, %d iterations, %.2f s", round_ + 1, status, its, took)
         run.exact = exact.copy() if exact_rows else None
         if status in SOLVER_ERRORS or status.startswith("exception"):
-            run.verified = None  # q is not a solver iterate: never accept it
+            run.verified, run.violation = None, None  # q is not a solver iterate: never accept it
             return q, stats, False
         cert = certify(problem.scene, q, margin=problem.certified_clearance)
-        run.verified = cert
+        run.verified, run.violation = cert, None
         if cert.ok:
-            return q, stats, True
+            run.violation = path_violation(problem, q)  # max_step, joint limits
+            if run.violation is None:
+                return q, stats, True
+            log.info("check: %s", run.violation)
+            run.verified = None  # certified, but not a path of the problem: never accept it
+            return q, stats, False
         bad = list(cert.bad_segments)
         log.info("certify: %d segment(s) not proven clear (more check points there)", len(bad))
         refined = splits.copy()

@@ -16,7 +16,7 @@ from ..arm3d.scene3d import Scene3D
 from ..assets import default_weights
 from ..distance import signed_distance
 from ..errors import InfeasibleProblemError, InputError
-from ..limits import MAX_CHECK_POINTS
+from ..limits import MAX_CHECK_POINTS, MAX_ITER, MAX_SEED, check_int
 from ..models import CoalModel, DistanceModel, load_model
 from ..scene import Scene
 from ..timing import limit_vector, plan_timing
@@ -26,7 +26,7 @@ from .ik import first_joint_barrier, tip_point, tip_position
 from .ipopt import _plan_ipopt
 from .options import TrajoptOptions
 from .polish import polish, repair
-from .problem import Problem
+from .problem import Problem, check_reachable_in_steps
 from .result import Plan, _finish
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
@@ -110,9 +110,13 @@ def plan(
     default None: velocity limits only), one number or one per joint, time the certified path
     (:func:`gdnplan.timing.time_path`, ``Plan.times``).
 
-    Raises GdnplanError on bad input; a failed solve returns ``Plan(success=False, reason=…)``.
+    Raises GdnplanError on bad input (InputError naming ``problem`` or ``seed``, an integer in
+    [0, ``limits.MAX_SEED``]); a failed solve returns ``Plan(success=False, reason=…)``.
     """
     t0 = time.perf_counter()
+    if not isinstance(problem, Problem):
+        raise InputError(f"problem: expected a gdnplan.Problem, got {type(problem).__name__}")
+    check_int(seed, "seed", 0, MAX_SEED)
     cfg = plan_config(problem, solver, options)
     _check_sizes(problem, cfg)
     dof = problem.scene.robot.dof
@@ -121,7 +125,10 @@ def plan(
     if max_acceleration is not None:
         max_acceleration = limit_vector(max_acceleration, dof, "max_acceleration", "rad/s²")
     model = resolve_model(collision, problem.scene, weights)
-    goal = problem.goal if problem.goal is not None else numeric_ik(problem, seed)
+    goal = problem.goal
+    if goal is None:  # the joint goal of goal_position: the step bound must still reach it
+        goal = numeric_ik(problem, seed)
+        check_reachable_in_steps(problem.start, goal, problem.max_step, problem.waypoints)
     deadline = t0 + finite_budget(cfg.seed.time_budget)
     if isinstance(cfg.optimizer, IpoptConfig):
         run = _plan_ipopt(problem, model, goal, cfg, seed, deadline)
@@ -196,8 +203,15 @@ def numeric_ik(
 
     Batched damped least squares Δq = Jᵀ(JJᵀ + λ²I)⁻¹ e from the start and ``restarts`` random
     configurations, clipped to the limits; among solutions within ``goal_tolerance`` and clear
-    of the margin, the one closest to the start. Raises InfeasibleProblemError if none exists.
+    of the margin, the one closest to the start. Raises InfeasibleProblemError if none exists;
+    InputError naming ``seed`` (an integer in [0, MAX_SEED]), ``restarts`` ([0, 10 000]) or
+    ``iterations`` ([1, MAX_ITER]) when out of range.
     """
+    if not isinstance(problem, Problem) or problem.goal_position is None:
+        raise InputError("problem: expected a gdnplan.Problem with a goal position")
+    check_int(seed, "seed", 0, MAX_SEED)
+    check_int(restarts, "restarts", 0, 10_000)
+    check_int(iterations, "iterations", 1, MAX_ITER)
     robot, target = problem.scene.robot, problem.goal_position
     rng = np.random.default_rng(seed)
     q = np.vstack([problem.start, rng.uniform(problem.lower, problem.upper, (restarts, robot.dof))])

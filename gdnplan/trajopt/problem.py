@@ -32,6 +32,26 @@ from .problem_file import ProblemTables, _vector, problem_tables, read_problem_f
 POSE_GOAL_SPARE = 1e-3  # m: a pose goal's IK keeps the margin plus this (coal's slack)
 
 
+def check_reachable_in_steps(start, goal, max_step: float, waypoints: int) -> None:
+    """InputError naming ``options.max_step`` when T = ``waypoints`` cannot reach ``goal``
+    from ``start`` (rad) with steps of at most ``max_step`` (rad) per joint:
+    max_step · (T − 1) < the largest joint distance; it says how many waypoints would."""
+    gap = np.abs(np.asarray(goal, float) - np.asarray(start, float))
+    j = int(np.argmax(gap))
+    need = float(gap[j])
+    if need <= max_step * (waypoints - 1) * (1 + 1e-12):
+        return
+    ratio = need / max_step  # may be huge (max_step = 1e-300) or inf: never an int then
+    wanted = f"{math.ceil(ratio) + 1}" if ratio < 1e15 else f"{ratio:.3g}"
+    wanted = wanted if math.isfinite(ratio) else "more than any"
+    raise InputError(
+        f"options.max_step: {max_step:g} rad per step cannot reach the goal in "
+        f"{waypoints} waypoints ({waypoints - 1} steps): joint {j} moves {need:.4g} rad from "
+        f"start to goal, which needs {wanted} waypoints (options.waypoints ≤ {MAX_WAYPOINTS}); "
+        f"raise max_step to at least {need / (waypoints - 1):.4g} rad or add waypoints"
+    )
+
+
 @dataclass(frozen=True, eq=False)
 class Problem:
     """A planning problem: move the robot of ``scene`` from ``start`` to a goal.
@@ -120,6 +140,8 @@ class Problem:
         if self.solver is not None and not isinstance(self.solver, PlanConfig):
             raise InputError(f"solver: expected a PlanConfig, got {type(self.solver).__name__}")
         self._check_feasible()
+        if self.goal is not None:  # after the limits: a goal outside them is named first
+            check_reachable_in_steps(self.start, self.goal, self.max_step, self.waypoints)
 
     def _check_clearance(self) -> None:
         """clearance: None or a finite number in [0, margin]."""
@@ -180,11 +202,13 @@ class Problem:
                 )
         if self.goal_position is not None:
             robot = self.scene.robot
-            r = float(np.linalg.norm(self.goal_position - robot.chain.joint_origins[0]))
+            base = np.asarray(robot.chain.joint_origins[0], float)[:2]
+            r = math.hypot(*(self.goal_position - base))  # no overflow for [1e300, 0.5]
             if r > tip_reach(robot):
                 raise InfeasibleProblemError(
-                    f"goal.position {self.goal_position.tolist()} is out of reach: {r:.3f} m "
-                    f"from the base, the tip reaches {tip_reach(robot):.3f} m"
+                    f"goal.position {self.goal_position.tolist()} is out of reach: "
+                    f"{r:.4g} m from the base, the tip reaches {tip_reach(robot):.3f} m; give "
+                    "a position within reach (metres)"
                 )
 
     @classmethod

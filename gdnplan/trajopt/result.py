@@ -19,6 +19,10 @@ from .seeds import SeedInfo
 
 log = logging.getLogger("gdnplan.trajopt")  # one logger for the package: the stage lines
 
+STEP_TOL = 1e-6  # rad: a path keeps max_step and the joint limits within this (Ipopt's
+# interior point ends a hair outside a bound: it relaxes bounds by 1e-8 of their size)
+IPOPT_SUCCESS = ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+
 
 @dataclass(frozen=True, eq=False)
 class Plan:
@@ -107,40 +111,91 @@ class _Run:
     model_calls: int = 0
     attempts: int = 0
     verified: Certificate | None = None  # q's certificate at the certified clearance, if made
+    violation: str | None = None  # the constraint q breaks (path_violation), when checked
     seed: SeedInfo | None = None  # the seed q was refined from, when certified
     exact: np.ndarray | None = None  # (T − 1,) segments whose check points q's solve gave coal rows
 
 
+def path_violation(problem: Problem, q: np.ndarray) -> str | None:
+    """Which constraint of ``problem`` other than clearance and goal the path q (T, dof)
+    breaks, beyond :data:`STEP_TOL`: finite values, the fixed start, the joint limits
+    (``lower``/``upper``) and ``max_step``; None when it keeps them all."""
+    if not np.all(np.isfinite(q)):
+        return "the path holds NaN or infinite joint values"
+    if np.max(np.abs(q[0] - problem.start)) > STEP_TOL:
+        return "the path does not begin at start.q"
+    below, above = problem.lower - q, q - problem.upper
+    for name, excess in (("options.lower", below), ("options.upper", above)):
+        if np.max(excess) > STEP_TOL:
+            t, j = np.unravel_index(np.argmax(excess), excess.shape)
+            return (
+                f"{name}: waypoint {t} has joint {j} = {q[t, j]:.6g} rad, "
+                f"{excess[t, j]:.3g} rad beyond the limit (tolerance {STEP_TOL:g} rad)"
+            )
+    steps = np.abs(np.diff(q, axis=0))
+    if np.max(steps) > problem.max_step + STEP_TOL:
+        t, j = np.unravel_index(np.argmax(steps), steps.shape)
+        return (
+            f"options.max_step: joint {j} moves {steps[t, j]:.6g} rad between waypoints {t} and "
+            f"{t + 1}, over max_step = {problem.max_step:g} rad (tolerance {STEP_TOL:g} rad)"
+        )
+    return None
+
+
 def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
-    """Certify the path with coal, check the goal, package the Plan."""
+    """Certify the path with coal, check the goal and every other constraint of the problem
+    (:func:`path_violation`), package the Plan: ``success`` only when all hold, else
+    ``reason`` names the first that failed."""
     clearance = problem.certified_clearance
-    cert = run.verified or certify(problem.scene, run.q, margin=clearance)
-    reached = _goal_error(problem, run.q[-1]) <= problem.goal_tolerance
+    broken = path_violation(problem, run.q)
+    finite = broken is None or np.all(np.isfinite(run.q))
+    cert = None
+    if finite:
+        cert = run.verified or certify(problem.scene, run.q, margin=clearance)
+    reached = finite and _goal_error(problem, run.q[-1]) <= problem.goal_tolerance
     reason = run.reason
-    if not cert.ok:
+    if cert is None:
+        reason = f"{reason}; {broken}"
+    elif not cert.ok:
         reason = (
             f"{reason}; coal certificate of clearance > {clearance:g} m failed: {cert.reason} "
             f"(smallest checked distance {cert.min_distance:+.4f} m)"
         )
     elif not reached:
         reason = f"{reason}; goal not reached"
-    verdict = f"ok, clearance ≥ {cert.lower_bound:+.4f} m" if cert.ok else "not proven"
-    log.info("certify: coal certificate %s%s", verdict, "" if reached else "; goal not reached")
+    elif broken is not None:
+        reason = f"{reason}; {broken}"
+    success = bool(cert is not None and cert.ok and reached and broken is None)
+    if success and _is_ipopt_failure(run.status):
+        reason = (
+            f"{reason}; Ipopt did not report success ({run.status}), but its path was checked "
+            "and keeps every constraint (certified clearance, goal, joint limits, max_step)"
+        )
+    ok = cert is not None and cert.ok
+    verdict = f"ok, clearance ≥ {cert.lower_bound:+.4f} m" if ok else "not proven"
+    why = "" if not ok or success else ("; goal not reached" if not reached else f"; {broken}")
+    log.info("certify: coal certificate %s%s", verdict, why)
     return Plan(
-        success=bool(cert.ok and reached),
+        success=success,
         q=run.q,
-        min_distance=cert.lower_bound,
+        min_distance=-np.inf if cert is None else cert.lower_bound,
         solve_time=time.perf_counter() - t0,
         iterations=run.iterations,
         status=run.status,
         reason=reason.lstrip("; "),
-        path_cost=path_cost(run.q),
+        path_cost=path_cost(run.q) if finite else np.inf,
         model_calls=run.model_calls,
         attempts=run.attempts,
-        sampled_min_distance=cert.min_distance,
+        sampled_min_distance=-np.inf if cert is None else cert.min_distance,
         clearance=clearance,
         seed=run.seed,
     )
+
+
+def _is_ipopt_failure(status: str) -> bool:
+    """An Ipopt return status (one word, e.g. Infeasible_Problem_Detected) other than
+    :data:`IPOPT_SUCCESS`; gdnplan's own statuses ("adam: …", "straight line …") are not."""
+    return bool(status) and " " not in status and status not in IPOPT_SUCCESS
 
 
 def _goal_error(problem: Problem, q: np.ndarray) -> float:
