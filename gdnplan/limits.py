@@ -7,6 +7,7 @@ Booleans are never numbers, strings never numbers (``margin = true`` is no 1 m).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,36 +26,77 @@ MAX_RRT_TIME = 600.0  # s, one RRT-Connect run
 MAX_DRAWS = 1000  # BatchedGraphDistNet draws: each is a whole pass over the samples
 MAX_TIMED_SAMPLES = 1_000_000  # TimedTrajectory.sample: time samples of one call
 
-# Ipopt options an [ipopt.options] table may set: name -> float, int, or the allowed strings
-IPOPT_OPTIONS: dict[str, type | tuple[str, ...]] = {
-    "tol": float,
-    "acceptable_tol": float,
-    "acceptable_iter": int,
-    "acceptable_obj_change_tol": float,
-    "acceptable_constr_viol_tol": float,
-    "constr_viol_tol": float,
-    "dual_inf_tol": float,
-    "compl_inf_tol": float,
-    "max_iter": int,
-    "max_cpu_time": float,
-    "max_wall_time": float,
-    "mu_init": float,
+MAX_SEED = 2**62  # plan(seed=…): seed i of a call draws the stream seed + i
+MAX_IPOPT_NUMBER = 1e20  # Ipopt's own "no limit" default (max_cpu_time, …): larger is refused
+# (bound_push = 1e300 overflows inside Ipopt and hangs a factorisation for minutes)
+
+
+@dataclass(frozen=True)
+class IpoptRange:
+    """The values an Ipopt number or integer option takes: Ipopt's documented range
+    (``print_options_documentation``, Ipopt 3.14), cut at :data:`MAX_IPOPT_NUMBER` (numbers) or
+    ``MAX_ITER`` (iteration counts)."""
+
+    kind: type  # float or int
+    low: float
+    high: float
+    open_low: bool = False  # low itself excluded
+    open_high: bool = False  # high itself excluded
+
+    def text(self) -> str:
+        """The range as an interval, e.g. '(0, 0.5]'."""
+        low, high = (f"{x:g}".replace("e+", "e") for x in (self.low, self.high))
+        return f"{'(' if self.open_low else '['}{low}, {high}{')' if self.open_high else ']'}"
+
+    def holds(self, value: float) -> bool:
+        """``value`` lies in the range."""
+        above = value > self.low if self.open_low else value >= self.low
+        below = value < self.high if self.open_high else value <= self.high
+        return above and below
+
+
+POSITIVE = IpoptRange(float, 0.0, MAX_IPOPT_NUMBER, open_low=True)  # Ipopt's 0 < x < +inf
+NON_NEGATIVE = IpoptRange(float, 0.0, MAX_IPOPT_NUMBER)  # Ipopt's 0 ≤ x < +inf
+COUNT = IpoptRange(int, 0, MAX_ITER)  # Ipopt's 0 ≤ n < +inf, cut at gdnplan's iteration cap
+
+# Ipopt options an [ipopt.options] table may set: name -> its range, or the allowed strings
+IPOPT_OPTIONS: dict[str, IpoptRange | tuple[str, ...]] = {
+    "tol": POSITIVE,
+    "acceptable_tol": POSITIVE,
+    "acceptable_iter": COUNT,
+    "acceptable_obj_change_tol": NON_NEGATIVE,
+    "acceptable_constr_viol_tol": POSITIVE,
+    "constr_viol_tol": POSITIVE,
+    "dual_inf_tol": POSITIVE,
+    "compl_inf_tol": POSITIVE,
+    "max_iter": COUNT,
+    "max_cpu_time": POSITIVE,
+    "max_wall_time": POSITIVE,
+    "mu_init": POSITIVE,
     "mu_strategy": ("monotone", "adaptive"),
     "mu_oracle": ("probing", "loqo", "quality-function"),
-    "hessian_approximation": ("exact", "limited-memory"),
-    "limited_memory_max_history": int,
+    "hessian_approximation": ("limited-memory",),
+    "limited_memory_max_history": COUNT,
     "limited_memory_initialization": ("scalar1", "scalar2", "scalar3", "scalar4", "constant"),
     "limited_memory_update_type": ("bfgs", "sr1"),
-    "nlp_scaling_method": ("none", "user-scaling", "gradient-based", "equilibration-based"),
-    "bound_push": float,
-    "bound_frac": float,
-    "bound_relax_factor": float,
+    "nlp_scaling_method": ("none", "gradient-based"),
+    "bound_push": POSITIVE,
+    "bound_frac": IpoptRange(float, 0.0, 0.5, open_low=True),
+    "bound_relax_factor": NON_NEGATIVE,
     "warm_start_init_point": ("yes", "no"),
-    "warm_start_bound_push": float,
-    "warm_start_slack_bound_push": float,
-    "warm_start_mult_bound_push": float,
+    "warm_start_bound_push": POSITIVE,
+    "warm_start_slack_bound_push": POSITIVE,
+    "warm_start_mult_bound_push": POSITIVE,
     "linear_solver": ("mumps",),
-    "print_level": int,
+    "print_level": IpoptRange(int, 0, 12),
+}
+# string values Ipopt knows that gdnplan cannot run, and why
+IPOPT_REFUSED = {
+    ("hessian_approximation", "exact"): "the distance rows have first derivatives only (an "
+    "exact Hessian would need the model's second derivatives); keep limited-memory",
+    ("nlp_scaling_method", "user-scaling"): "gdnplan gives Ipopt no scaling factors",
+    ("nlp_scaling_method", "equilibration-based"): "it needs HSL's MC19, which the CasADi "
+    "wheels do not ship",
 }
 
 
@@ -86,7 +128,8 @@ def check_int(value, name: str, low: int, high: int) -> int:
 
 def check_ipopt(options) -> None:
     """InputError unless ``options`` maps known Ipopt option names (:data:`IPOPT_OPTIONS`) to
-    values of their type (a bad name or value makes CasADi raise and Ipopt print to stdout)."""
+    values of their type in their range (a bad name or value makes Ipopt stop with
+    Invalid_Option and print its option help to stdout)."""
     if not isinstance(options, dict):
         raise InputError(f"ipopt: expected a table of Ipopt options, got {options!r}")
     for key, value in options.items():
@@ -97,9 +140,25 @@ def check_ipopt(options) -> None:
                 f"{where}: unknown or unsupported option; allowed: {sorted(IPOPT_OPTIONS)}"
             )
         if isinstance(kind, tuple):
+            if (key, value) in IPOPT_REFUSED:
+                raise InputError(
+                    f"{where}: {value!r} is not supported: {IPOPT_REFUSED[key, value]}; "
+                    f"choose one of {list(kind)}"
+                )
             if value not in kind:
                 raise InputError(f"{where}: expected one of {list(kind)}, got {value!r}")
-        elif kind is int:
-            check_int(value, where, 0, 10**9)
         else:
-            check_number(value, where, 0.0, strict=True)
+            check_ipopt_number(value, where, kind)
+
+
+def check_ipopt_number(value, where: str, allowed: IpoptRange) -> None:
+    """InputError naming ``where`` and the range unless ``value`` is a number (an integer for
+    an integer option) in ``allowed``."""
+    what = "an integer" if allowed.kind is int else "a number"
+    typed = (
+        isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+        if allowed.kind is int
+        else is_number(value)
+    )
+    if not typed or not math.isfinite(value) or not allowed.holds(value):
+        raise InputError(f"{where}: expected {what} in {allowed.text()}, got {value!r}")

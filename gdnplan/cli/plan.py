@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import ctypes
 import json
 import math
+import os
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -116,14 +121,15 @@ def plan_command(
     if collision is None:
         collision = "coal" if is_3d(problem.scene) else "graphdistnet"
     config = plan_flags_config(problem, solver, seeds, time_budget)
-    result = plan(
-        problem,
-        collision=collision,
-        solver=config,
-        weights=weights,
-        seed=seed,
-        max_acceleration=max_acceleration,
-    )
+    with stdout_to_stderr(json_output):  # --json: Ipopt's print_level log must not reach stdout
+        result = plan(
+            problem,
+            collision=collision,
+            solver=config,
+            weights=weights,
+            seed=seed,
+            max_acceleration=max_acceleration,
+        )
     if json_output:
         typer.echo(json.dumps(plan_summary(result, problem.scene.robot.joint_names)))
     else:
@@ -154,6 +160,35 @@ def plan_command(
         view_plan([(problem.scene, shown if is_3d(problem.scene) else result.q)])
     if not result.success:
         raise typer.Exit(1)
+
+
+@contextmanager
+def stdout_to_stderr(active: bool = True) -> Iterator[None]:
+    """While active, file descriptor 1 (stdout) points at stderr: what native code prints
+    (Ipopt's log at ``print_level`` > 0, CasADi's warnings) goes to stderr, so ``--json``
+    stdout holds the JSON object alone. Python's and C's stdout buffers are flushed on both
+    sides of the switch."""
+    if not active:
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        sys.stdout.flush()
+        _flush_c_stdio()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _flush_c_stdio() -> None:
+    """fflush(NULL): C stdio's buffered output (Ipopt prints through it) written out now."""
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):  # no C library to ask (not expected on Linux/macOS)
+        pass
 
 
 def is_3d(scene) -> bool:

@@ -8,9 +8,11 @@ import casadi
 import numpy as np
 
 from ..casadi_bridge import DistanceCallback
+from ..errors import InputError
 from ..models import DistanceModel
 from .check_points import _interpolation_matrix, _path_parameters
 from .config import IpoptConfig
+from .interrupt import StopOnInterrupt, interruptible
 from .problem import Problem
 
 WARM_START_OPTIONS = {  # Ipopt options of refine rounds started from the last primal-dual point
@@ -81,12 +83,16 @@ class _Transcription:
         ipopt.update(opts.options)
         if warm:  # a refine round: start from the last round's primal-dual point
             ipopt.update(WARM_START_OPTIONS)
-        self.solver = casadi.nlpsol(
-            "trajopt",
-            "ipopt",
-            {"x": x, "f": f, "g": g},
-            {"ipopt": ipopt, "print_time": False, "error_on_fail": False},
-        )
+        self.stop = StopOnInterrupt(x.numel(), g.numel())  # Ctrl-C: stop at the next iteration
+        settings = {"print_time": False, "error_on_fail": False, "iteration_callback": self.stop}
+        try:
+            nlp = {"x": x, "f": f, "g": g}
+            self.solver = casadi.nlpsol("trajopt", "ipopt", nlp, {"ipopt": ipopt, **settings})
+        except RuntimeError as e:  # limits.check_ipopt keeps Ipopt's ranges: not expected
+            raise InputError(
+                f"ipopt.options: Ipopt refused the options {opts.options!r} "
+                f"({str(e).splitlines()[-1][:200]}); see docs/problem_file.md#ipoptoptions"
+            ) from e
 
     def solve(
         self, guess: np.ndarray, duals: tuple[np.ndarray, np.ndarray] | None = None
@@ -98,7 +104,8 @@ class _Transcription:
         if duals is not None:
             bounds.update(lam_g0=duals[0], lam_x0=duals[1])
         try:
-            sol = self.solver(x0=x0, **bounds)
+            with interruptible():  # Ctrl-C: Ipopt stops, then KeyboardInterrupt here
+                sol = self.solver(x0=x0, **bounds)
         except RuntimeError as e:
             return guess, {"return_status": f"exception: {str(e).splitlines()[-1]}"[:200]}
         self.duals = (np.asarray(sol["lam_g"]).ravel(), np.asarray(sol["lam_x"]).ravel())
