@@ -29,9 +29,11 @@ class Plan:
     """Result of :func:`plan`.
 
     Attributes:
-        success: the goal is reached and the coal certificate proves that the whole continuous
+        success: the goal is reached, the coal certificate proves that the whole continuous
             path keeps a signed distance > ``clearance`` (the problem's certified clearance:
-            its margin unless ``Problem.clearance`` asks for less), not only at check points.
+            its margin unless ``Problem.clearance`` asks for less), not only at check points,
+            and the path keeps the problem's joint limits and ``max_step`` (within
+            :data:`STEP_TOL`, :func:`path_violation`), whatever the solver's status said.
         q: (T, dof) waypoints (rad).
         min_distance: proven lower bound on the coal signed distance over the whole continuous
             path (m; the certificate of :func:`gdnplan.ccd.certify_path`, within 1 mm of the
@@ -42,7 +44,9 @@ class Plan:
         solve_time: wall time of the whole call: seeds, solves, verification (s); the time
             parametrisation after them is not included.
         iterations: solver iterations summed over attempts.
-        status: the solver's last return status (Ipopt's, or "adam: …").
+        status: the solver's last return status (Ipopt's, or "adam: …"); an Ipopt status
+            other than Solve_Succeeded / Solved_To_Acceptable_Level on a successful plan is
+            explained in ``reason`` (the path passed every check anyway).
         reason: why the plan failed (or which attempt succeeded).
         path_cost: Σ_t ‖q_{t+1} − q_t‖² (rad²).
         model_calls: batched distance-model calls made by the solver.
