@@ -19,6 +19,7 @@ SQUARE = Path(__file__).parent.parent / "problems" / "planar2_square.toml"
 FREE3D = """
 [robot]
 name = "ur5e"
+{held}
 
 [scene3d]
 [[scene3d.obstacles]]
@@ -34,6 +35,11 @@ q = [-0.6, -1.2, 1.2, -1.5, -1.57, 0.0]
 {goal}
 """
 GOAL_Q = "q = [0.6, -1.2, 1.2, -1.5, -1.57, 0.0]"
+HELD = """[robot.held]
+type = "box"
+size = [0.03, 0.03, 0.25]
+position = [0.0, 0.0, 0.12]
+quaternion = {}"""
 
 
 def write(tmp_path: Path, text: str) -> Path:
@@ -56,16 +62,20 @@ def toml_number(x: float) -> str:
         ([math.inf, 0.0, 0.0, 1.0], "not finite"),
     ],
 )
-@pytest.mark.parametrize("where", ["goal", "obstacle"])
+@pytest.mark.parametrize("where", ["goal", "obstacle", "held"])
 def test_a_bad_quaternion_is_named_as_one(tmp_path, quat, words, where):
     text = "[" + ", ".join(toml_number(x) for x in quat) + "]"
+    parts = {"held": "", "obstacle_rotation": "", "goal": GOAL_Q}
     if where == "goal":
-        goal = f"pose = {{ position = [0.3, 0.3, 0.4], quaternion = {text} }}"
-        path = write(tmp_path, FREE3D.format(obstacle_rotation="", goal=goal))
+        parts["goal"] = f"pose = {{ position = [0.3, 0.3, 0.4], quaternion = {text} }}"
         field = "[goal] pose quaternion"
-    else:
-        path = write(tmp_path, FREE3D.format(obstacle_rotation=f"quaternion = {text}", goal=GOAL_Q))
+    elif where == "obstacle":
+        parts["obstacle_rotation"] = f"quaternion = {text}"
         field = "[[scene3d.obstacles]] 0 quaternion"
+    else:
+        parts["held"] = HELD.format(text)
+        field = "quaternion"
+    path = write(tmp_path, FREE3D.format(**parts))
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no overflow RuntimeWarning on the way
         with pytest.raises(ProblemFileError) as info:
@@ -77,7 +87,7 @@ def test_a_bad_quaternion_is_named_as_one(tmp_path, quat, words, where):
 
 def test_an_unnormalised_quaternion_is_still_accepted(tmp_path):
     path = write(
-        tmp_path, FREE3D.format(obstacle_rotation="quaternion = [0, 0, 2, 2]", goal=GOAL_Q)
+        tmp_path, FREE3D.format(held="", obstacle_rotation="quaternion = [0, 0, 2, 2]", goal=GOAL_Q)
     )
     assert Problem.from_toml(path).scene.obstacles
 

@@ -12,7 +12,6 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GdnplanError, InputError, ProblemFileError
-from ..limits import is_number
 from ..scene import no_unknown_keys
 from .ik3d import solve_pose_ik
 from .robot3d import Robot3D
@@ -30,30 +29,6 @@ from .shape_file3d import (
 SCENE3D_KEYS = frozenset({"random_boxes", "obstacles"})
 RANDOM_BOXES_KEYS = frozenset({"n", "seed", "size", "base_clearance"})
 POSE_GOAL_KEYS = frozenset({"position", "frame", *ROTATION_KEYS})
-MAX_QUATERNION = 1e3  # largest |component| of a quaternion (it is normalised; 1 is usual)
-
-
-def check_quaternion(table, where: str) -> None:
-    """ProblemFileError naming ``where`` quaternion unless a table's ``quaternion`` (when it
-    has one) is 4 finite numbers, none beyond :data:`MAX_QUATERNION`, of nonzero length
-    (computed without overflow); the length is normalised away, so give a unit quaternion."""
-    if not isinstance(table, dict) or not isinstance(table.get("quaternion"), list):
-        return  # rotation_of names any other shape
-    value = table["quaternion"]
-    if len(value) != 4 or not all(is_number(x) for x in value):
-        return
-    quat = np.asarray(value, float)
-    if not np.all(np.isfinite(quat)):
-        raise ProblemFileError(
-            f"{where} quaternion: {value!r} is not finite; give a unit quaternion [x, y, z, w]"
-        )
-    big = float(np.max(np.abs(quat)))
-    length = big * float(np.linalg.norm(quat / big)) if big > 0 else 0.0  # no overflow
-    if big > MAX_QUATERNION or length < 1e-9:
-        raise ProblemFileError(
-            f"{where} quaternion: {value!r} has length {length:.3g}, not near 1; give a unit "
-            "quaternion [x, y, z, w] (a rotation, not a position; zero length is refused)"
-        )
 
 
 def pose_goal(scene: Scene3D, table, reference, margin: float) -> np.ndarray:
@@ -70,7 +45,6 @@ def pose_goal(scene: Scene3D, table, reference, margin: float) -> np.ndarray:
     frame = table.get("frame")
     if frame is not None and not isinstance(frame, str):
         raise ProblemFileError(f"{where} frame: expected a frame name, got {frame!r}")
-    check_quaternion(table, where)
     rotation = rotation_of(table, where)
     try:
         solved = solve_pose_ik(scene, table["position"], rotation, reference, frame, margin)
@@ -103,8 +77,6 @@ def scene3d_from_config(cfg: dict, base_dir=None) -> Scene3D:
     listed = table.get("obstacles", [])
     if not isinstance(listed, list):
         raise ProblemFileError("[scene3d] obstacles: expected [[scene3d.obstacles]] tables")
-    for k, t in enumerate(listed):
-        check_quaternion(t, f"[[scene3d.obstacles]] {k}")
     obstacles += [obstacle_from_table(t, k, base) for k, t in enumerate(listed)]
     try:
         return Scene3D(robot, obstacles)
@@ -133,7 +105,6 @@ def _random_boxes(spec, robot: Robot3D) -> list[Obstacle3D]:
 
 
 __all__ = [  # OBSTACLE3D_KEYS … rpy_matrix: re-exported from where they now live
-    "MAX_QUATERNION",
     "OBSTACLE3D_KEYS",
     "POSE_GOAL_KEYS",
     "POSE_KEYS",
@@ -141,7 +112,6 @@ __all__ = [  # OBSTACLE3D_KEYS … rpy_matrix: re-exported from where they now l
     "ROBOT3D_KEYS",
     "ROTATION_KEYS",
     "SCENE3D_KEYS",
-    "check_quaternion",
     "obstacle_from_table",
     "pose_goal",
     "robot_from_table",

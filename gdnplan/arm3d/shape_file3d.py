@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GdnplanError, ProblemFileError
+from ..limits import is_number
 from ..scene import no_unknown_keys
 from .cloud3d import DEFAULT_RESOLUTION, cloud_obstacle, read_cloud
 from .scene3d import (
@@ -62,6 +63,29 @@ def file_path(value, base_dir: Path, where: str) -> Path:
     return base_dir / value
 
 
+MAX_QUATERNION = 1e3  # largest |component| of a quaternion (it is normalised; 1 is usual)
+
+
+def check_quaternion(value: list, where: str) -> None:
+    """ProblemFileError naming ``where`` quaternion unless ``value`` (4 items) is 4 finite
+    numbers, none beyond :data:`MAX_QUATERNION`, of nonzero length (computed without
+    overflow); the length is normalised away, so give a unit quaternion."""
+    if not all(is_number(x) for x in value):
+        return  # as_rotation names a non-number
+    quat = np.asarray(value, float)
+    if not np.all(np.isfinite(quat)):
+        raise ProblemFileError(
+            f"{where} quaternion: {value!r} is not finite; give a unit quaternion [x, y, z, w]"
+        )
+    big = float(np.max(np.abs(quat)))
+    length = big * float(np.linalg.norm(quat / big)) if big > 0 else 0.0  # no overflow
+    if big > MAX_QUATERNION or length < 1e-9:
+        raise ProblemFileError(
+            f"{where} quaternion: {value!r} has length {length:.3g}, not near 1; give a unit "
+            "quaternion [x, y, z, w] (a rotation, not a position; zero length is refused)"
+        )
+
+
 def rotation_of(table: dict, where: str):
     """The rotation a table gives (quaternion, rpy or matrix; None: identity)."""
     given = [k for k in ROTATION_KEYS if k in table]
@@ -75,6 +99,8 @@ def rotation_of(table: dict, where: str):
         return rpy_matrix_checked(value, f"{where} rpy")
     if key == "quaternion" and not (isinstance(value, list) and len(value) == 4):
         raise ProblemFileError(f"{where} quaternion: expected [x, y, z, w], got {value!r}")
+    if key == "quaternion":
+        check_quaternion(value, where)
     if key == "matrix" and not (
         isinstance(value, list) and len(value) == 3 and all(isinstance(r, list) for r in value)
     ):
