@@ -228,12 +228,18 @@ class Robot:
         return float(np.max(hops[body] + np.linalg.norm(self.nodes0 - o[body], axis=1)))
 
     # ---------------------------------------------------------------- sampling and checks
-    def sample(self, n: int, seed: int | Sequence[int] | None = 0) -> np.ndarray:
-        """(n, dof) configurations uniform within the joint limits; n an integer in
-        [0, MAX_SAMPLES] and ``seed`` as :func:`check_seed` allows, else InputError."""
+    def sample(
+        self, n: int, seed: int | Sequence[int] | np.random.Generator | None = 0
+    ) -> np.ndarray:
+        """(n, dof) configurations uniform within the joint limits (rad).
+
+        ``n`` is an integer in [0, MAX_SAMPLES]; ``seed`` is what :func:`check_seed` allows
+        (None, an integer ≥ 0 or a list of them) or a ``numpy.random.Generator``, which is
+        drawn from directly, so sampling continues the caller's stream (and advances it), as
+        ``np.random.default_rng(generator)`` always did. Anything else is an InputError.
+        """
         check_int(n, "n", 0, MAX_SAMPLES)
-        rng = np.random.default_rng(check_seed(seed))
-        return rng.uniform(self.lower, self.upper, size=(n, self.dof))
+        return make_rng(seed).uniform(self.lower, self.upper, size=(n, self.dof))
 
     def check_q(self, q: np.ndarray, name: str = "q") -> np.ndarray:
         """Validate joint angles: returns a float64 (B, dof) array; raises InputError otherwise."""
@@ -388,6 +394,15 @@ def check_seed(seed, name: str = "seed"):
                 f"{name}: expected None, an integer ≥ 0 or a list of them, got {seed!r}"
             )
     return seed
+
+
+def make_rng(seed, name: str = "seed") -> np.random.Generator:
+    """The generator of ``seed``: a ``numpy.random.Generator`` itself (drawn from directly, its
+    stream continues, as ``np.random.default_rng(generator)`` does), else
+    ``np.random.default_rng`` of a seed :func:`check_seed` allows (InputError otherwise)."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    return np.random.default_rng(check_seed(seed, name))
 
 
 # -------------------------------------------------------------------- registry

@@ -49,3 +49,19 @@ def test_active_learning_7dof_c_to_d():
     before = roc_auc(-model.distance(scene, q), collide)
     after = roc_auc(-model.adapt(scene, n_explore=2000, seed=0).distance(scene, q), collide)
     assert after > before + 0.1
+
+
+def test_adapt_draws_as_before_the_seed_check(model_a):
+    """adapt's pool is bit-identical to the pre-check code: one generator of ``seed`` draws the
+    perturbations, then continues into the uniform exploration samples (regression: the
+    seed check refused the generator and `reproduce table1` failed)."""
+    scene = gp.make_scene("b", seed=3)
+    robot = model_a.kernel.robot
+    new = model_a.adapt(scene, n_explore=64, seed=4, max_iter=10)
+    rng = np.random.default_rng(4)
+    near = np.repeat(model_a.support, 2, 0)
+    near = np.clip(near + rng.normal(0, 0.1, near.shape), robot.lower, robot.upper)
+    explore = rng.uniform(robot.lower, robot.upper, size=(64, robot.dof))
+    np.testing.assert_array_equal(new.pool, np.concatenate([model_a.support, near, explore]))
+    again = model_a.adapt(scene, n_explore=64, seed=np.random.default_rng(4), max_iter=10)
+    np.testing.assert_array_equal(again.pool, new.pool)

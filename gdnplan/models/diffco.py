@@ -39,7 +39,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..distance import signed_distance
-from ..robot import Robot
+from ..robot import Robot, make_rng
 from ..scene import Scene
 
 CHUNK = 1024  # query rows per kernel block
@@ -177,7 +177,7 @@ class DiffCo:
         n_exploit: int = 2,
         n_explore: int = 500,
         sigma: float = 0.1,
-        seed: int = 0,
+        seed: int | np.random.Generator | None = 0,
         max_iter: int = 20_000,
     ) -> DiffCo:
         """Active-learning update to a changed environment (labels from coal in ``scene``).
@@ -186,14 +186,15 @@ class DiffCo:
             scene: the new environment (same robot).
             n_exploit: Gaussian perturbations (σ = ``sigma`` rad per joint) per support point.
             n_explore: uniform random configurations.
-            seed: sampling seed.
+            seed: sampling seed: None, an integer ≥ 0, a list of them or a
+                ``numpy.random.Generator`` (its stream continues), else InputError.
             max_iter: perceptron update budget.
 
         Returns:
             A new DiffCo (perceptron score; call :meth:`fitted` for the surrogate).
         """
         robot = self.kernel.robot
-        rng = np.random.default_rng(seed)
+        rng = make_rng(seed)
         near = np.repeat(self.support, n_exploit, 0)
         near = np.clip(near + rng.normal(0, sigma, near.shape), robot.lower, robot.upper)
         q = np.concatenate([self.support, near, robot.sample(n_explore, seed=rng)])
