@@ -48,11 +48,14 @@ GRID_PER_SEGMENT = 8  # toppra grid cells per waypoint segment (fewer above MAX_
 MAX_GRID = 4000  # toppra grid points at most
 BEFORE_KNOT = (1e-6, 1e-3, 1e-2, 0.0)  # grid points this share of a segment before inner knots
 STRETCH_SLACK = 1e-9  # c is raised by this fraction (rounding of the cell bounds)
+LIMIT_RANGE = (1e-6, 1e9)  # max_velocity (rad/s) and max_acceleration (rad/s²) allowed
+MAX_ANGLE = 1e6  # rad, |q| of a waypoint: beyond it the times' squares could overflow
 KINDS = ("linear", "smooth", "stop")
 
 
 def limit_vector(value, dof: int, name: str, unit: str) -> np.ndarray:
-    """(dof,) limits from one number or dof numbers, each finite and > 0, else InputError."""
+    """(dof,) limits from one number or dof numbers, each in :data:`LIMIT_RANGE` (10⁻⁶ … 10⁹
+    ``unit``; beyond it a path's times or their squares leave float64), else InputError."""
     if is_number(value):
         value = [value] * dof
     items = list(value) if isinstance(value, (list, tuple, np.ndarray)) else None
@@ -61,7 +64,31 @@ def limit_vector(value, dof: int, name: str, unit: str) -> np.ndarray:
     out = np.asarray(items, float)
     if not np.all(np.isfinite(out) & (out > 0)):
         raise InputError(f"{name}: expected finite limits > 0 ({unit}), got {out.tolist()}")
+    low, high = LIMIT_RANGE
+    if not np.all((out >= low) & (out <= high)):
+        raise InputError(
+            f"{name}: expected limits in [{low:g}, {high:g}] {unit}, got {out.tolist()}"
+        )
     return out
+
+
+def check_waypoints(q) -> np.ndarray:
+    """q as float64 (T, dof) waypoints, T ≥ 1, dof ≥ 1, real and finite with |q| ≤
+    :data:`MAX_ANGLE` rad, else InputError naming ``q``."""
+    try:
+        arr = np.asarray(q)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"q: expected (T, dof) waypoints (rad), got {type(q).__name__}") from e
+    if arr.dtype.kind not in "iuf":
+        raise InputError(f"q: expected real numbers (rad), got an array of {arr.dtype}")
+    if arr.ndim != 2 or arr.shape[0] < 1 or arr.shape[1] < 1:
+        raise InputError(f"q: expected (T, dof) waypoints with T, dof ≥ 1, got shape {arr.shape}")
+    arr = arr.astype(float)
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"q: expected finite (T, dof) waypoints (rad), got shape {arr.shape}")
+    if np.max(np.abs(arr)) > MAX_ANGLE:
+        raise InputError(f"q: waypoints beyond ±{MAX_ANGLE:g} rad are no joint angles")
+    return arr
 
 
 def urdf_velocity(robot: Robot | Robot3D) -> np.ndarray:
@@ -124,7 +151,8 @@ class TimedTrajectory:
         ``dt`` must be finite and > 0, and give at most ``MAX_TIMED_SAMPLES`` samples.
         """
         check_number(dt, "dt", strict=True)
-        n = math.floor(self.duration / dt) + 2
+        ratio = self.duration / dt
+        n = math.floor(ratio) + 2 if ratio < MAX_TIMED_SAMPLES else MAX_TIMED_SAMPLES + 1
         if n > MAX_TIMED_SAMPLES:
             raise InputError(
                 f"dt: {dt:g} s gives {n} samples of a {self.duration:.3f} s trajectory, the limit "
@@ -164,7 +192,7 @@ class _Stops:
     def __init__(self, q: np.ndarray, v: np.ndarray, a: np.ndarray):
         self.q, self.step = q, np.diff(q, axis=0)
         size = np.abs(self.step)
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", over="ignore"):  # a tiny step: no motion
             vs = np.min(v / size, axis=1, initial=np.inf) if len(size) else np.zeros(0)
             acc = np.min(a / size, axis=1, initial=np.inf) if len(size) else np.zeros(0)
         moving = np.isfinite(vs)
@@ -346,8 +374,9 @@ def time_path(
     """Time-parametrise the certified waypoint path q (T, dof) rad; see the module docstring.
 
     Args:
-        q: (T, dof) finite waypoints (rad), T ≥ 1.
-        max_velocity: velocity limit (rad/s), one number or dof numbers, each > 0.
+        q: (T, dof) finite waypoints (rad), T ≥ 1, dof ≥ 1, |q| ≤ :data:`MAX_ANGLE`.
+        max_velocity: velocity limit (rad/s), one number or dof numbers, each in
+            :data:`LIMIT_RANGE` (10⁻⁶ … 10⁹), so the duration and every time stay finite.
         max_acceleration: acceleration limit (rad/s²) likewise; None: ``linear``.
         scene: with max_acceleration, try the ``smooth`` curve and certify it here (a planar
             ``Scene`` or a ``Scene3D``); None (or a curve whose certificate fails, or toppra
@@ -357,9 +386,7 @@ def time_path(
             follows keeps what the plan promised; else ``stop`` (the certified polygon).
     """
     check_number(clearance, "clearance")
-    q = np.asarray(q, float)
-    if q.ndim != 2 or len(q) < 1 or not np.all(np.isfinite(q)):
-        raise InputError(f"q: expected finite (T, dof) waypoints (rad), got shape {q.shape}")
+    q = check_waypoints(q)
     v = limit_vector(max_velocity, q.shape[1], "max_velocity", "rad/s")
     if max_acceleration is None:
         prof = _Linear(q, v)
@@ -373,7 +400,7 @@ def time_path(
         curve = PchipInterpolator(knots, q[np.unique(index, return_index=True)[1]], axis=0)
         cert = certify_curve(scene, curve, margin=clearance)
         prof = _toppra(curve, knots, v, a) if cert.ok else None
-        if prof is not None:
+        if prof is not None and math.isfinite(prof.c * prof.ts[-1]):
             at_knots = prof.c * prof.ts[np.searchsorted(prof.grid, knots)]
             times = at_knots[index]
             return TimedTrajectory("smooth", times, q, v, a, cert.lower_bound, prof)
