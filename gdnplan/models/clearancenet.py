@@ -31,7 +31,7 @@ from torch import nn
 
 from ..errors import InputError
 from ..geometry import pad_polygons
-from ..scene import Scene, make_scene
+from ..scene import Scene, check_scene, make_scene
 from .checks import build_net, card_config, check_count, check_fits, check_layout
 from .fields import (
     MAX_LENGTH,
@@ -239,10 +239,12 @@ class ClearanceNetModel:
             )
 
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        check_scene(scene, "planar", "a 3-D model (ClearanceNet3D)")
         q = scene.robot.check_q(q)
         return self._run(q, self._scene_vector(scene, len(q)), False)[0]
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        check_scene(scene, "planar", "a 3-D model (ClearanceNet3D)")
         q = scene.robot.check_q(q)
         return self._run(q, self._scene_vector(scene, len(q)), True)
 

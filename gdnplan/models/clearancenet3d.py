@@ -17,6 +17,7 @@ from torch import nn
 
 from ..arm3d import Scene3D
 from ..errors import InputError
+from ..scene import check_scene
 
 
 @dataclass(frozen=True)
@@ -76,6 +77,7 @@ class ClearanceNet3DModel:
         self.dtype = dtype
 
     def _inputs(self, scene: Scene3D, q) -> tuple[torch.Tensor, torch.Tensor]:
+        check_scene(scene, "3d", "a planar model (ClearanceNet)")
         q = torch.as_tensor(scene.robot.check_q(q), dtype=self.dtype)
         o = torch.as_tensor(scene_vector(scene, self.net.config.n_boxes), dtype=self.dtype)
         return q, o.expand(len(q), -1)

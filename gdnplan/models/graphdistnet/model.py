@@ -14,7 +14,7 @@ import torch
 
 from ...errors import InputError
 from ...graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
-from ...scene import Scene
+from ...scene import Scene, check_scene
 from ..checks import check_fits
 from ..threads import check_threads, torch_threads
 from . import fused as fused_kernel
@@ -141,6 +141,7 @@ class GraphDistNetModel:
 
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
         """(B,) estimated signed distances (m) of q (B, dof) or (dof,)."""
+        check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
         with torch_threads(self.threads) as threads:
             graphs = self._graphs(scene)  # outside inference mode: the cache serves autograd too
@@ -158,6 +159,7 @@ class GraphDistNetModel:
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad)."""
+        check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
         with torch_threads(self.threads) as threads:
             graphs = self._graphs(scene)

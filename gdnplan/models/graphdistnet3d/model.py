@@ -30,6 +30,7 @@ from ...graph3d import (
     robot_graph3d,
     scene_graph3d,
 )
+from ...scene import check_scene
 from ..threads import check_threads, torch_threads
 from . import fused3d
 from .fit import check_fits3d
@@ -175,6 +176,7 @@ class GraphDistNet3DModel:
 
     def learned_distance(self, scene: Scene3D, q) -> np.ndarray:
         """(B,) d̂ of the robot–obstacle distance alone (m)."""
+        check_scene(scene, "3d", "a planar model (gdnplan.load_model of planar weights)")
         q = scene.robot.check_q(q)
         with torch_threads(self.threads):
             c = self._cache(scene)
@@ -190,6 +192,7 @@ class GraphDistNet3DModel:
 
     def learned_distance_and_grad(self, scene: Scene3D, q) -> tuple[np.ndarray, np.ndarray]:
         """(B,), (B, dof): d̂ of the robot–obstacle distance (m) and ∂d̂/∂q (m/rad)."""
+        check_scene(scene, "3d", "a planar model (gdnplan.load_model of planar weights)")
         q = scene.robot.check_q(q)
         ds, gs = [], []
         with torch_threads(self.threads):

@@ -1,0 +1,36 @@
+"""Every learned model's distance entry points refuse what is no scene of their kind with an
+InputError naming ``scene`` (not an AttributeError from inside), like the exact functions
+(``gdnplan.scene.check_scene``)."""
+
+import numpy as np
+import pytest
+
+import gdnplan as gp
+from gdnplan.arm3d import Scene3D, load_robot3d
+from gdnplan.errors import InputError
+
+PLANAR = gp.make_scene("b", seed=0)
+SPACE = Scene3D(load_robot3d("ur5e"), [])
+WRONG = [None, "b", 5, np.zeros(3), object()]
+
+
+def entries(model) -> list:
+    names = ["distance", "distance_and_grad", "learned_distance", "learned_distance_and_grad"]
+    return [getattr(model, n) for n in names if hasattr(model, n)]
+
+
+@pytest.mark.parametrize("weights", ["b", "b_faithful", "clearancenet_b"])
+@pytest.mark.parametrize("scene", [*WRONG, SPACE])
+def test_planar_models_refuse_other_scenes(weights, scene):
+    model = gp.load_model(weights)
+    for entry in entries(model):
+        with pytest.raises(InputError, match="scene"):
+            entry(scene, np.zeros(2))
+
+
+@pytest.mark.parametrize("scene", [*WRONG, PLANAR])
+def test_3d_models_refuse_other_scenes(scene):
+    model = gp.load_model("ur5e_boxes3d_preliminary")
+    for entry in entries(model):
+        with pytest.raises(InputError, match="scene"):
+            entry(scene, np.zeros(6))
