@@ -28,6 +28,7 @@ from .ccd import Certificate, proven_distance
 from .errors import InputError
 from .exact import certify, exact_distance
 from .limits import check_number
+from .robot import as_batch, first_outside
 from .rrt import edge_free
 from .scene import Scene
 
@@ -125,11 +126,55 @@ def _check(scene: Scene, start, goal, lower, upper, clearance, time_limit, plann
     check_number(clearance, "clearance")
     if check_number(time_limit, "time_limit", strict=True) > MAX_TIME:
         raise InputError(f"time_limit: {time_limit} s is over the limit {MAX_TIME} s")
-    lower = robot.lower if lower is None else np.asarray(lower, float)
-    upper = robot.upper if upper is None else np.asarray(upper, float)
-    start = robot.check_q(np.asarray(start, float), "start").reshape(-1)
-    goal = robot.check_q(np.asarray(goal, float), "goal").reshape(-1)
+    lower, upper = _check_box(robot, lower, upper)
+    start, goal = (
+        _check_state(robot, q, n, lower, upper) for q, n in ((start, "start"), (goal, "goal"))
+    )
     return start, goal, lower, upper
+
+
+def _vector(robot, value, name: str) -> np.ndarray:
+    """One configuration (dof,) of finite real numbers (rad), else InputError naming ``name``."""
+    try:
+        shape = np.shape(value)
+    except ValueError:  # ragged nesting
+        shape = "a ragged list"
+    if shape != (robot.dof,):
+        raise InputError(f"{name}: expected shape ({robot.dof},) (rad), got {shape}")
+    return as_batch(value, robot.dof, name)[0]
+
+
+def _check_box(robot, lower, upper) -> tuple[np.ndarray, np.ndarray]:
+    """The joint box: (dof,) finite bounds (rad) within the robot's joint limits and
+    lower < upper on every joint (the robot's limits when None), else InputError naming them."""
+    lower = _vector(robot, robot.lower if lower is None else lower, "lower")
+    upper = _vector(robot, robot.upper if upper is None else upper, "upper")
+    for name, value in (("lower", lower), ("upper", upper)):
+        j = first_outside(value, robot.lower, robot.upper)
+        if j is not None:
+            raise InputError(
+                f"{name}[{j}] = {value[j]:.4g} rad is outside the robot's joint range "
+                f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}]; narrow it"
+            )
+    flat = np.flatnonzero(lower >= upper)
+    if flat.size:
+        j = int(flat[0])
+        raise InputError(
+            f"lower[{j}] = {lower[j]:.4g} rad must be below upper[{j}] = {upper[j]:.4g} rad"
+        )
+    return lower, upper
+
+
+def _check_state(robot, q, name: str, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """start or goal (dof,) rad inside the joint box, else InputError naming it."""
+    q = _vector(robot, q, name)
+    j = first_outside(q, lower, upper)
+    if j is not None:
+        raise InputError(
+            f"{name}[{j}] = {q[j]:.4g} rad is outside the joint box "
+            f"[{lower[j]:.4g}, {upper[j]:.4g}] (lower, upper)"
+        )
+    return q
 
 
 def plan_ompl(
@@ -152,7 +197,10 @@ def plan_ompl(
     the planner then gets (1 − ``SIMPLIFY_SHARE``) of ``time_limit`` (an anytime planner uses
     all of it, RRT-Connect stops at its first path and leaves the rest to simplification).
     ``OmplResult.time`` is the whole wall time (the final certificate included).
-    ``lower``/``upper`` (dof,): the joint box (the robot's limits when None). ``seed`` seeds
+    ``lower``/``upper`` (dof,) rad: the joint box, finite, within the robot's joint limits
+    (1e-9 rad of slack), lower < upper on every joint, start and goal inside it (the robot's
+    limits when None; InputError naming ``lower``, ``upper``, ``start`` or ``goal`` otherwise,
+    before OMPL is imported). ``seed`` seeds
     OMPL's generators the first time any planner runs in this process (OMPL allows one global
     seed); a run is reproducible for the same seed and sequence of calls up to time limits (an
     anytime planner's result depends on how far it got in its time). Raises InputError on bad

@@ -60,3 +60,35 @@ def test_bad_input_and_missing_ompl(square, monkeypatch):
     monkeypatch.setitem(sys.modules, "ompl", None)  # import ompl now raises ImportError
     with pytest.raises(InputError, match=r"gdnplan\[bench\]"):
         plan_ompl(p.scene, p.start, p.goal, 0.02)
+
+
+NAN = float("nan")
+
+
+@pytest.mark.parametrize(
+    ("lower", "upper", "match"),
+    [
+        ([0.0], None, r"lower: expected shape \(2,\)"),  # was IndexError
+        ([1.0, 1.0], [0.0, 0.0], r"lower\[0\] = 1 rad must be below upper\[0\]"),  # was OMPL's
+        ([NAN, 0.0], None, "lower: contains NaN"),  # was 'q_path: contains NaN'
+        (None, [1.0, float("inf")], "upper: contains NaN or infinite"),
+        (None, [10.0, 1.0], r"upper\[0\] = 10 rad is outside the robot's joint range"),
+        ([True, False], None, "lower: expected real numbers"),
+        ("ab", None, r"lower: expected shape \(2,\)"),
+        ([[0.0], [0.0, 1.0]], None, "lower: expected shape"),
+        ([-1.0, -1.0], [0.0, 0.0], r"start\[0\] = .* is outside the joint box"),
+    ],
+)
+def test_bad_joint_boxes_are_input_errors_naming_them(square, lower, upper, match):
+    p = square
+    with pytest.raises(InputError, match=match):
+        plan_ompl(p.scene, p.start, p.goal, 0.02, lower=lower, upper=upper)
+
+
+def test_a_box_within_the_robots_limits_is_accepted(square):
+    p = square
+    r = plan_ompl(
+        p.scene, p.start, p.goal, 0.02, time_limit=0.5, lower=p.lower * 0.99, upper=p.upper
+    )
+    assert r.path.shape[1] == 2
+    assert np.all(r.path >= p.lower * 0.99 - 1e-12)
