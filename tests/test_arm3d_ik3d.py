@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gdnplan.arm3d import Scene3D, box_obstacle, checker3d, load_robot3d
-from gdnplan.arm3d.ik3d import frame_pose, solve_pose_ik, tool_frame
+from gdnplan.arm3d.ik3d import MIN_TOL, cartesian_path, frame_pose, solve_pose_ik, tool_frame
 from gdnplan.errors import InfeasibleProblemError, InputError
 
 
@@ -104,3 +104,78 @@ def test_bad_positions_frames_and_references_are_input_errors():
         solve_pose_ik(robot, [0.4, 0.1, 0.3], frame="no_such_frame")
     with pytest.raises(InputError, match="reference"):
         solve_pose_ik(robot, [0.4, 0.1, 0.3], reference=np.zeros(5))
+
+
+UR5E_Q = np.array([0.2, -1.3, 1.5, -1.8, -1.57, 0.4])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"position_tol": 1e-300}, "position_tol: 1e-300 is below 1e-12"),
+        ({"rotation_tol": 1e-13}, "rotation_tol: 1e-13 is below 1e-12"),
+        ({"position_tol": float("nan")}, "position_tol"),
+    ],
+)
+def test_tolerances_below_what_the_solver_reaches_are_refused(kwargs, match):
+    robot = load_robot3d("ur5e")
+    target = _fk(robot, UR5E_Q, "gripper_tcp")
+    with pytest.raises(InputError, match=match):
+        solve_pose_ik(robot, target.translation, target.rotation, **kwargs)
+
+
+def test_the_smallest_tolerance_is_reached_on_a_reachable_pose():
+    robot = load_robot3d("ur5e")
+    target = _fk(robot, UR5E_Q, "gripper_tcp")
+    sol = solve_pose_ik(
+        robot, target.translation, target.rotation, margin=-1.0, position_tol=MIN_TOL,
+        rotation_tol=MIN_TOL,
+    )  # fmt: skip
+    assert sol.position_error <= MIN_TOL
+
+
+def test_an_unmet_tolerance_on_a_reachable_pose_is_not_out_of_reach():
+    robot = load_robot3d("ur5e")
+    target = _fk(robot, UR5E_Q, "gripper_tcp")
+    with pytest.raises(InfeasibleProblemError, match="tolerance was not met") as err:
+        solve_pose_ik(
+            robot, target.translation, target.rotation, reference=UR5E_Q + 0.02, margin=-1.0,
+            restarts=1, iterations=2,
+        )  # fmt: skip
+    assert "out of reach" not in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("positions", "kwargs", "match"),
+    [
+        ([[1, 2]], {}, r"positions: expected \(K, 3\)"),
+        ("abc", {}, r"positions: expected \(K, 3\)"),
+        ([[1], [1, 2, 3]], {}, r"positions: expected \(K, 3\)"),
+        (np.zeros((0, 3)), {}, r"positions: expected \(K, 3\)"),
+        ([[0.4, 0.1, np.nan]], {}, r"positions\[0\]: contains NaN"),
+        ([[0.4, 0.1, "0.3"]], {}, r"positions\[0\]: expected 3 numbers"),
+        ([[0.4, 0.1, 0.3]], {"max_jump": float("nan")}, "max_jump"),
+        ([[0.4, 0.1, 0.3]], {"max_jump": 0.0}, "max_jump"),
+        ([[0.4, 0.1, 0.3]], {"margin": float("inf")}, "margin"),
+        ([[0.4, 0.1, 0.3]], {"frame": "nope"}, "frame"),
+        ([[0.4, 0.1, 0.3]], {"rotation": [0, 0, 0, 0]}, "rotation"),
+    ],
+)
+def test_cartesian_path_refuses_bad_arguments_by_name(positions, kwargs, match):
+    robot = load_robot3d("ur5e")
+    rotation = kwargs.pop("rotation", _fk(robot, UR5E_Q, "gripper_tcp").rotation)
+    with pytest.raises(InputError, match=match):
+        cartesian_path(robot, UR5E_Q, positions, rotation, **kwargs)
+
+
+def test_cartesian_path_takes_one_point_or_several():
+    robot = load_robot3d("ur5e")
+    tcp = _fk(robot, UR5E_Q, "gripper_tcp")
+    up = tcp.translation + np.array([0.0, 0.0, 0.01])
+    one = cartesian_path(robot, UR5E_Q, tcp.translation, tcp.rotation, margin=-1.0)
+    two = cartesian_path(
+        robot, UR5E_Q, [tcp.translation, up], tcp.rotation,
+        margin=-1.0,
+    )  # fmt: skip
+    assert one.shape == (2, 6) and two.shape == (3, 6)
+    assert np.linalg.norm(frame_pose(robot, two[-1]).translation - up) < 1e-4

@@ -41,6 +41,12 @@ from .shapes import as_rotation, as_vector
 TOOL_FRAMES = {"ur5e": "gripper_tcp", "panda": "panda_hand_tcp", "ur5": "tool0"}
 DAMPING = 1e-3  # λ of the damped least squares (m or rad)
 MAX_STEP = 0.5  # rad: largest joint change of one step (|Δq|∞, scaled down)
+MIN_TOL = 1e-12  # m, rad: smallest position_tol / rotation_tol (the DLS reaches ~1e-14 at 1 m)
+NEAR = (
+    1e-3,
+    1e-2,
+)  # m, rad: a closest miss within these is "tolerance not met", not "out of reach"
+MAX_POINTS = 10_000  # cartesian_path: positions of one path
 
 
 @dataclass(frozen=True)
@@ -106,23 +112,26 @@ def _dls(
     iterations: int,
     position_tol: float,
     rotation_tol: float,
-) -> np.ndarray | None:
-    """Damped least squares from q0 (dof,): the converged q within the limits, or None."""
+) -> tuple[np.ndarray | None, tuple[float, float]]:
+    """Damped least squares from q0 (dof,): (the converged q within the limits, or None;
+    (|e_lin| m, |e_ang| rad) at the last iterate)."""
     model, data = robot.model, robot.data
     q = np.clip(np.asarray(q0, dtype=float), robot.lower, robot.upper)
     eye = np.eye(6)
+    miss = (np.inf, np.inf)
     for _ in range(iterations):
         pin.framesForwardKinematics(model, data, q)
         err_pose = data.oMf[fid].actInv(target)
         err = pin.log6(err_pose).vector
-        if np.linalg.norm(err[:3]) <= position_tol and np.linalg.norm(err[3:]) <= rotation_tol:
-            return q
+        miss = (float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:])))
+        if miss[0] <= position_tol and miss[1] <= rotation_tol:
+            return q, miss
         jac = pin.computeFrameJacobian(model, data, q, fid, pin.ReferenceFrame.LOCAL)
         jac = -pin.Jlog6(err_pose.inverse()) @ jac
         step = -jac.T @ np.linalg.solve(jac @ jac.T + DAMPING**2 * eye, err)
         step *= min(1.0, MAX_STEP / max(float(np.abs(step).max()), 1e-12))
         q = np.clip(q + step, robot.lower, robot.upper)
-    return None
+    return None, miss
 
 
 def nearest_equivalent(robot: Robot3D, q: np.ndarray, reference: np.ndarray) -> np.ndarray:
@@ -159,13 +168,17 @@ def solve_pose_ik(
         restarts: start configurations tried at most (the reference, then random ones);
             solutions: stop after this many distinct collision-free solutions.
         seed: of the random starts. iterations: DLS steps per start.
-        position_tol (m), rotation_tol (rad): convergence of |e_lin|, |e_ang|.
+        position_tol (m), rotation_tol (rad): convergence of |e_lin|, |e_ang|, each finite and
+            ≥ :data:`MIN_TOL` (10⁻¹²: float64 forward kinematics of a ~1 m arm is exact to
+            ~10⁻¹⁵, and the DLS reaches ~10⁻¹⁴; smaller tolerances are refused).
 
     Raises:
         InputError: a position that is not 3 finite numbers, a rotation that is not a rotation,
             an unknown frame, a reference of the wrong shape.
-        InfeasibleProblemError: no start converged (the pose is out of reach), or every
-            converged solution is closer than ``margin`` to an obstacle or the robot itself.
+        InfeasibleProblemError: no start converged (the message gives the closest miss: within
+            :data:`NEAR` it says the tolerance was not met, else that the pose is out of
+            reach), or every converged solution is closer than ``margin`` to an obstacle or the
+            robot itself.
     """
     scene = scene if isinstance(scene, Scene3D) else Scene3D(scene)
     robot = scene.robot
@@ -175,8 +188,9 @@ def solve_pose_ik(
     check_int(restarts, "restarts", 1, 100_000)
     check_int(solutions, "solutions", 1, 100_000)
     check_int(iterations, "iterations", 1, 100_000)
-    check_number(position_tol, "position_tol", 0.0, strict=True)
-    check_number(rotation_tol, "rotation_tol", 0.0, strict=True)
+    for name, tol in (("position_tol", position_tol), ("rotation_tol", rotation_tol)):
+        if check_number(tol, name, 0.0, strict=True) < MIN_TOL:
+            raise InputError(f"{name}: {tol:g} is below {MIN_TOL:g}, what the IK solver reaches")
     mid = (robot.lower + robot.upper) / 2
     ref = mid if reference is None else robot.check_q(reference, "reference")[0]
     rng = np.random.default_rng(seed)
@@ -184,10 +198,12 @@ def solve_pose_ik(
     found: list[tuple[np.ndarray, float]] = []
     converged = 0
     attempts = 0
+    closest = (np.inf, np.inf)
     for attempts in range(1, restarts + 1):
         start = ref if attempts == 1 else robot.random_configurations(1, rng)[0]
-        q = _dls(robot, fid, target, start, iterations, position_tol, rotation_tol)
+        q, miss = _dls(robot, fid, target, start, iterations, position_tol, rotation_tol)
         if q is None:
+            closest = min(closest, miss, key=lambda m: max(m[0] / NEAR[0], m[1] / NEAR[1]))
             continue
         converged += 1
         q = nearest_equivalent(robot, q, ref)
@@ -199,9 +215,10 @@ def solve_pose_ik(
     if not found:
         where = f"position {np.round(target.translation, 4).tolist()} m"
         if converged == 0:
+            why = _miss_text(closest, position_tol, rotation_tol)
             raise InfeasibleProblemError(
                 f"goal pose: no IK solution for {tool_frame(robot) if frame is None else frame} "
-                f"at {where} in {attempts} starts; the pose is out of reach"
+                f"at {where} in {attempts} starts; {why}"
             )
         raise InfeasibleProblemError(
             f"goal pose: {converged} IK solutions at {where}, none with clearance ≥ {margin} m"
@@ -209,6 +226,18 @@ def solve_pose_ik(
     q, d = min(found, key=lambda f: float(np.linalg.norm(f[0] - ref)))
     pos, ang = _errors(frame_pose(robot, q, frame), target)
     return PoseIK(q, pos, ang, d, attempts, len(found))
+
+
+def _miss_text(closest: tuple[float, float], position_tol: float, rotation_tol: float) -> str:
+    """Why no start converged, from the closest miss (m, rad)."""
+    pos, ang = closest
+    text = f"closest: {pos:.3g} m, {ang:.3g} rad"
+    if pos <= NEAR[0] and ang <= NEAR[1]:
+        return (
+            f"the tolerance was not met ({text}; position_tol {position_tol:g} m, rotation_tol "
+            f"{rotation_tol:g} rad): raise the tolerances or iterations"
+        )
+    return f"the pose is out of reach, or needs more restarts or iterations ({text})"
 
 
 def cartesian_path(
@@ -223,12 +252,20 @@ def cartesian_path(
     """(K + 1, dof) joint path q0, q_1 … q_K through tool ``positions`` (K, 3) (m) at one
     ``rotation``, each q_k the IK solution nearest q_{k−1} with clearance ≥ ``margin`` (m).
 
+    ``positions``: one point (3,) or K in 1 … :data:`MAX_POINTS` points (K, 3), finite (m);
+    ``rotation``: a quaternion (x, y, z, w) or 3×3 rotation matrix; ``margin``: finite (m);
+    ``max_jump``: finite and > 0 (rad); ``frame`` a frame of the robot (None: the tool frame);
+    q0 (dof,) rad. InputError naming the argument otherwise, before any IK is solved.
     Raises InfeasibleProblemError naming the point when it has no clear solution within
     ``max_jump`` (rad, largest joint change) of the previous one.
     """
     scene = scene if isinstance(scene, Scene3D) else Scene3D(scene)
     q = [scene.robot.check_q(q0, "q0")[0]]
-    pts = np.asarray(positions, dtype=float).reshape(-1, 3)
+    pts = _positions(positions)
+    rotation = as_rotation(rotation, "rotation")
+    check_number(margin, "margin", -np.inf)
+    check_number(max_jump, "max_jump", 0.0, strict=True)
+    _frame_id(scene.robot, frame)
     for k, p in enumerate(pts):
         sol = None
         for restarts in (1, 8):
@@ -248,6 +285,21 @@ def cartesian_path(
             )
         q.append(sol.q)
     return np.array(q)
+
+
+def _positions(positions) -> np.ndarray:
+    """(K, 3) tool positions (m) from one point (3,) or K points, else InputError."""
+    try:
+        items = np.asarray(positions, dtype=object)
+    except ValueError:  # ragged nesting
+        items = np.asarray(None, dtype=object)
+    if items.shape == (3,):
+        items = items[None]
+    if items.ndim != 2 or items.shape[1] != 3 or not 1 <= len(items) <= MAX_POINTS:
+        raise InputError(
+            f"positions: expected (K, 3) points (m), 1 ≤ K ≤ {MAX_POINTS}, got {positions!r}"[:300]
+        )
+    return np.array([as_vector(list(p), 3, f"positions[{k}]") for k, p in enumerate(items)])
 
 
 __all__ = [
