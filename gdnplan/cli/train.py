@@ -24,14 +24,22 @@ def generate_command(
         ..., help="Environment: a-e, ur5e, or ur5e_boxes, ur5e_cloud, ur5e_storage (3-D)."
     ),
     split: str = typer.Option("train", help="train (seed 0) or test (seed 1)."),
-    n: int = typer.Option(None, min=1, help="Samples (default: the paper's 50 000 / 5 000)."),
+    n: int = typer.Option(
+        None,
+        min=1,
+        max=10**8,
+        help="Samples, 1 … 10⁸ (default: the paper's 50 000 / 5 000); ~150 B (2-DoF) to ~1.1 kB "
+        "(e) of disk each.",
+    ),
     seed: int = typer.Option(None, min=0, help="Override the split's seed."),
     near: float = typer.Option(
         0.0,
         help="Fraction of samples drawn near contact: around the fetch task (ur5e), "
         "|f| < 3 cm (a-e).",
     ),
-    workers: int = typer.Option(None, min=1, help="Worker processes (default: all cores)."),
+    workers: int = typer.Option(
+        None, min=1, help="Worker processes, 1 … 4 per core (default: all cores)."
+    ),
     data: Path = typer.Option(None, help="Data root (default data/): <data>/<env>/<split>."),
     ray: bool = typer.Option(
         False,

@@ -23,8 +23,11 @@ from tqdm import tqdm
 
 from ..errors import InputError
 from ..files import write_text
+from ..limits import is_number
 
 MANIFEST = "manifest.json"
+MAX_SPLIT = 10**8  # samples of one split: ~15 GB of planar 2-DoF shards, ~110 GB of (e)'s
+MAX_WORKERS = max(64, 4 * (os.cpu_count() or 1))  # processes of one run (four per core)
 
 
 def shard_plan(out_dir: Path | str, n: int, size: int) -> list[tuple[int, int, Path]]:
@@ -35,12 +38,28 @@ def shard_plan(out_dir: Path | str, n: int, size: int) -> list[tuple[int, int, P
     ]
 
 
-def check_split(n: object, near: float) -> None:
-    """InputError unless n is a positive int (not a bool) and near a fraction in [0, 1]."""
-    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
-        raise InputError(f"n: expected a positive number of samples, got {n!r}")
-    if not 0.0 <= near <= 1.0:
-        raise InputError(f"near: expected a fraction in [0, 1], got {near}")
+def check_split(n: object, near: object, workers: object = None) -> None:
+    """InputError unless n is an int (not a bool) in 1 … :data:`MAX_SPLIT` (a split's shards
+    take ~150 bytes (planar 2-DoF) to ~1.1 kB (environment e) of disk per sample), near a
+    fraction in [0, 1] and workers None or an int in 1 … :data:`MAX_WORKERS`."""
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= MAX_SPLIT:
+        raise InputError(
+            f"n: expected a number of samples in [1, {MAX_SPLIT:.0e}] (the limit), got {n!r}"
+        )
+    if not is_number(near) or not 0.0 <= near <= 1.0:
+        raise InputError(f"near: expected a fraction in [0, 1], got {near!r}")
+    check_workers(workers)
+
+
+def check_workers(workers: object) -> int | None:
+    """None (all cores) or an int (not a bool) in 1 … :data:`MAX_WORKERS`, else InputError."""
+    if workers is None:
+        return None
+    if isinstance(workers, bool) or not isinstance(workers, int | np.integer):
+        raise InputError(f"workers: expected None or an integer ≥ 1, got {workers!r}")
+    if not 1 <= workers <= MAX_WORKERS:
+        raise InputError(f"workers: {workers} is outside [1, {MAX_WORKERS}] (4 per core)")
+    return int(workers)
 
 
 def check_manifest(out_dir: Path, settings: Mapping, options: Mapping[str, str]) -> None:
@@ -98,7 +117,9 @@ def run_jobs(
     write: Callable[[object], int], jobs: Sequence, workers: int | None, bar: tqdm
 ) -> None:
     """``write(job)`` (it returns its sample count) for every job, in this process or on a
-    forked pool of ``workers`` processes (None: all cores), advancing ``bar``."""
+    forked pool of ``workers`` processes (None: all cores; else :func:`check_workers`),
+    advancing ``bar``."""
+    workers = check_workers(workers)
     workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
     if workers < 2:
         for job in jobs:

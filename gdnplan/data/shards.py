@@ -55,10 +55,10 @@ def generate(
 
     Args:
         env: environment name (``"a"`` … ``"e"``, ``"ur5e"``).
-        n: number of samples.
+        n: number of samples, 1 … ``MAX_SPLIT`` (10⁸; ~150 B to ~1.1 kB of disk each).
         seed: split seed (train 0, test 1 by convention, see ``SPLITS``).
         out_dir: directory of the shards (created).
-        workers: processes (default: all cores).
+        workers: processes, an int in 1 … ``MAX_WORKERS`` (default None: all cores).
         near: fraction of near-contact samples (module docstring: around the fetch task for
             ``ur5e``, at the collision boundary for a–e).
 
@@ -67,7 +67,7 @@ def generate(
     """
     if env not in ENVS:
         raise UnknownNameError(f"env: unknown environment {env!r}; choose one of {list(ENVS)}")
-    check_split(n, near)
+    check_split(n, near, workers)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     size = sampling.SHARD_SIZE
