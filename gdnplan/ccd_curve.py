@@ -6,7 +6,8 @@ configuration, so the bound holds along any joint curve, not only a straight one
 of :mod:`gdnplan.arm3d.ccd3d` (obstacle pairs and self pairs, Δ) is linear in the same per-joint
 travels, so one certificate serves both scene kinds: δ is the scene kind's motion bound
 (:func:`gdnplan.exact.motion_bound_of`) with |Δq_j| replaced by ∫|q̇_j| ds, and d the kind's
-exact distance (:func:`gdnplan.exact.exact_distance`, in 3-D self-collision included). A
+exact distance (:func:`gdnplan.exact.exact_distance` with the margin, in 3-D self-collision
+included, contact-only pairs with the offset of :mod:`gdnplan.arm3d.ccd3d`). A
 straight piece has ∫|q̇_j| = |Δq_j|; a cubic
 piece p_j(s), s ∈ [s_a, s_b], has the total variation TV_j = Σ_i |p_j(x_{i+1}) − p_j(x_i)| over
 x = s_a, the roots of the quadratic p'_j inside the piece, s_b (exact: p_j is monotone between
@@ -105,7 +106,8 @@ def certify_curve(
     s = np.linspace(0.0, 1.0, splits + 1)
     nodes = np.unique((x[:-1, None] + s[None] * np.diff(x)[:, None]).ravel())
     nodes = np.unique(np.concatenate([nodes, x]))
-    d = proven_distance(exact_distance(scene, robot.check_q(curve(nodes), "curve")))
+    q_nodes = robot.check_q(curve(nodes), "curve")
+    d = proven_distance(exact_distance(scene, q_nodes, margin=margin))
     sa, sb, da, db = nodes[:-1], nodes[1:], d[:-1], d[1:]
     n_checks, lower, best = len(nodes), math.inf, float(np.min(d))
     while len(sa):
@@ -121,7 +123,7 @@ def certify_curve(
             return CurveCertificate(False, -math.inf, n_checks)
         sa, sb, da, db = sa[keep], sb[keep], da[keep], db[keep]
         mid = (sa + sb) / 2
-        dm = proven_distance(exact_distance(scene, curve(mid))) if len(mid) else mid
+        dm = proven_distance(exact_distance(scene, curve(mid), margin=margin)) if len(mid) else mid
         n_checks += len(mid)
         best = min(best, float(np.min(dm))) if len(dm) else best
         sa, sb = np.concatenate([sa, mid]), np.concatenate([mid, sb])

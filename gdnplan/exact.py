@@ -14,6 +14,11 @@ Both scene kinds also share the attributes the planner reads: ``scene.robot`` wi
 ``lower``, ``upper`` (rad), ``joint_names``, ``name``, ``check_q`` and a Pinocchio ``model``
 (URDF velocity limits, :func:`gdnplan.timing.urdf_velocity`).
 
+3-D contact-only self pairs (:mod:`gdnplan.arm3d.pairs`) must keep d ≥ 0, not the margin:
+``exact_distance(scene, q, margin=M)`` and ``closest_pair(scene, q, margin=M)`` add M to their
+distances, so a result ≥ M means every pair meets its requirement; without a margin they are
+left out (the pairs a margin applies to). ``certify`` always proves both requirements.
+
 Dispatch is by the scene's (or robot's) type with :func:`functools.singledispatch`: the scene
 classes live in the core layer, below the coal geometry they would need as methods
 (``tests/test_layers.py``), so the geometry registers itself for them here. Another scene kind
@@ -22,12 +27,13 @@ joins by registering its own implementations (``exact_distance.register(MyScene)
 
 from __future__ import annotations
 
+import math
 from functools import singledispatch
 
 import numpy as np
 
 from .arm3d.ccd3d import certify_path3d, motion_bound3d
-from .arm3d.distance3d import checker3d, signed_distance3d
+from .arm3d.distance3d import checker3d
 from .arm3d.robot3d import Robot3D
 from .arm3d.scene3d import Scene3D
 from .ccd import Certificate, certify_path, motion_bound
@@ -44,21 +50,24 @@ def _unknown(what, kind: str):
 
 
 @singledispatch
-def exact_distance(scene, q, per_link: bool = False) -> np.ndarray:
+def exact_distance(scene, q, per_link: bool = False, margin: float | None = None) -> np.ndarray:
     """Exact signed distance (m) of configurations q (B, dof) or (dof,): (B,), or (B, n_links)
     with ``per_link``; positive apart, minus the penetration depth in collision (3-D:
-    self-collision included)."""
+    self-collision included). ``margin`` (m), the clearance the result is compared with: 3-D
+    contact-only self pairs count as d + margin (result ≥ margin ⟺ every pair meets its
+    requirement); None leaves them out. A planar scene has none."""
     raise _unknown(scene, "scene")
 
 
 @exact_distance.register
-def _(scene: Scene, q, per_link: bool = False) -> np.ndarray:
+def _(scene: Scene, q, per_link: bool = False, margin: float | None = None) -> np.ndarray:
     return signed_distance(scene, q, per_link=per_link)
 
 
 @exact_distance.register
-def _(scene: Scene3D, q, per_link: bool = False) -> np.ndarray:
-    return signed_distance3d(scene, q, per_link=per_link)
+def _(scene: Scene3D, q, per_link: bool = False, margin: float | None = None) -> np.ndarray:
+    offset = math.inf if margin is None else margin
+    return checker3d(scene).evaluate(q, per_link, contact_offset=offset).distance
 
 
 @singledispatch
@@ -115,25 +124,29 @@ def _(robot: Robot3D, qa, qb) -> np.ndarray:
 
 
 @singledispatch
-def closest_pair(scene, q) -> str:
+def closest_pair(scene, q, margin: float | None = None) -> str:
     """What is closest at one configuration q (dof,), for messages: ``"link 'a' and obstacle
-    3"`` (planar) or ``"forearm_link/... and box4"`` (3-D, self pairs name both links)."""
+    3"`` (planar) or ``"forearm_link/... and box4"`` (3-D, self pairs name both links);
+    ``margin`` as in :func:`exact_distance`."""
     raise _unknown(scene, "scene")
 
 
 @closest_pair.register
-def _(scene: Scene, q) -> str:
+def _(scene: Scene, q, margin: float | None = None) -> str:
     w = closest(scene, scene.robot.check_q(q))
     return f"link {int(w.link[0])} and an obstacle"
 
 
 @closest_pair.register
-def _(scene: Scene3D, q) -> str:
+def _(scene: Scene3D, q, margin: float | None = None) -> str:
     checker = checker3d(scene)
-    pair = int(checker.evaluate(q).pair[0])
+    offset = math.inf if margin is None else margin
+    pair = int(checker.evaluate(q, contact_offset=offset).pair[0])
     if pair < 0:
         return "no pair"
     a, b = checker.pair_names()[pair]
+    if checker.contact_only[pair]:
+        return f"{a} and {b} (self-collision, contact-only: must keep d ≥ 0)"
     return f"{a} and {b}" + (" (self-collision)" if checker.is_self[pair] else "")
 
 

@@ -95,7 +95,7 @@ def test_the_broad_phase_never_changes_the_minimum_below_the_cap(seed, cap, per_
     q = robot.random_configurations(3, np.random.default_rng(seed))
     brute, narrow_all = checker.pair_distances(q)  # every pair, no cap
     assert np.all(narrow_all == checker.n_pairs)
-    res = checker.evaluate(q, per_link=per_link, cap=cap)
+    res = checker.evaluate(q, per_link=per_link, cap=cap, contact_offset=0.0)  # every pair
     if per_link:
         for link in range(robot.n_links):
             involved = (checker.link_a == link) | (checker.link_b == link)
@@ -104,7 +104,7 @@ def test_the_broad_phase_never_changes_the_minimum_below_the_cap(seed, cap, per_
     else:
         np.testing.assert_array_equal(res.distance, np.minimum(brute.min(1), cap))
     assert np.all(res.narrow <= checker.n_pairs)
-    off = checker.evaluate(q, per_link=per_link, cap=cap, broad_phase=False)
+    off = checker.evaluate(q, per_link=per_link, cap=cap, broad_phase=False, contact_offset=0.0)
     np.testing.assert_array_equal(off.distance, res.distance)
 
 

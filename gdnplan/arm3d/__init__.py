@@ -16,7 +16,7 @@ distance with self-collision and its gradient.
 from __future__ import annotations
 
 from .builtin import load_robot3d, robot3d_names
-from .ccd3d import certify_path3d, lever_arms3d, motion_bound3d
+from .ccd3d import Certificate3D, certify_path3d, lever_arms3d, motion_bound3d
 from .cloud3d import cloud_obstacle, read_cloud
 from .distance3d import (
     Checker3D,
@@ -43,6 +43,7 @@ from .scene3d import (
 )
 
 __all__ = [
+    "Certificate3D",
     "Checker3D",
     "Coal3DModel",
     "Distances3D",

@@ -2,8 +2,12 @@
 
 * ``"ur5e"``: ``gdnplan/shipped/robots/ur5e.urdf``, all six arm joints planned, the gripper's
   fingers locked (open by default: ``finger`` m each, at most 0.0425), collision cylinders and
-  boxes; ``shipped/robots/ur5e.srdf`` disables the pairs Universal Robots' UR5 SRDF disables
-  (the same links) and the wrist-1/finger pairs (never closer than 8 cm in 5000 samples).
+  boxes; ``shipped/robots/ur5e.srdf`` disables base–upper arm (constant, 1.65 cm), wrist 1–
+  wrist 3 (never closer than 2.27 cm) and the finger pairs with wrist 1 and wrist 2 (never
+  closer than 8 cm in 5000 samples). The forearm against wrist 2 and wrist 3
+  (:data:`UR5E_CONTACT_ONLY`) are contact-only pairs: their cylinders stay within 1.45 cm
+  (wrist 2) of each other everywhere, so no 2 cm margin fits, yet they do interpenetrate
+  (down to −2.0 cm and −1.5 cm): they are checked for d ≥ 0 (:mod:`gdnplan.arm3d.pairs`).
 * ``"panda"``: example-robot-data's Franka Panda, seven joints, fingers locked at ``finger`` m
   (at most 0.04), collision meshes as convex hulls, the SRDF's disabled pairs.
 * ``"ur5"``: example-robot-data's UR5, six joints, collision meshes as hulls, its SRDF.
@@ -22,6 +26,7 @@ from ..ur5e.kinematics import JOINTS
 from .robot3d import Robot3D, robot3d_from_urdf
 
 UR5E_JOINTS = JOINTS  # all six arm joints, as the planar model names them
+UR5E_CONTACT_ONLY = (("forearm_link", "wrist_2_link"), ("forearm_link", "wrist_3_link"))
 PANDA_JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
 
 
@@ -41,7 +46,14 @@ def ur5e3d(finger: float = 0.02) -> Robot3D:
     locked = {"left_finger_joint": finger, "right_finger_joint": finger}
     urdf = robot_urdf("ur5e")
     srdf = urdf.with_suffix(".srdf")
-    return robot3d_from_urdf(urdf, joints=UR5E_JOINTS, locked=locked, srdf=srdf, name="ur5e")
+    return robot3d_from_urdf(
+        urdf,
+        joints=UR5E_JOINTS,
+        locked=locked,
+        srdf=srdf,
+        name="ur5e",
+        contact_only=UR5E_CONTACT_ONLY,
+    )
 
 
 def panda3d(finger: float = 0.02) -> Robot3D:

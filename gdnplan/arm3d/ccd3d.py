@@ -26,12 +26,28 @@ lower bounds d̲_a, d̲_b at the ends (coal's estimate minus ``COAL_SLACK`` (1 +
 and :func:`certify_path3d` bisects pieces until (1) exceeds the margin on every piece, or
 fails: a checked configuration within the margin, a piece too small to bisect, or the check
 budget spent — never an acceptance without a proof. Self-collision is included.
+
+Contact-only self pairs (:mod:`gdnplan.arm3d.pairs`) are proven out of contact, not clear of
+the margin M: the certificate runs on c(q) = min_k (d_k + o_k) with the offset o_k = M on
+contact-only pairs and 0 on every other pair (:mod:`gdnplan.arm3d.narrow3d`), and
+
+    c(q) > M   ⟺   d_k > M for every obstacle and ordinary self pair, d_k > 0 for every
+                   contact-only pair.
+
+o_k is constant, so c changes along a piece by at most Δ as every d_k does and (1) holds for c
+unchanged. coal's allowance stays valid: a checked c > M ≥ 0 has d_k > 0 on contact-only pairs,
+so |d_k + o_k| ≥ |d_k| and COAL_SLACK (1 + |c|) covers them. The reported ``lower_bound`` is a
+proven lower bound on c: on the obstacle and ordinary self clearance, and with
+``lower_bound − margin`` (> 0 when ``ok``) on the contact-only pairs' distances;
+``min_distance`` is the smallest checked c. :class:`Certificate3D` names the contact-only
+pairs proven.
 """
 
 from __future__ import annotations
 
 import math
 import weakref
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -42,6 +58,25 @@ from ..scene import check_scene
 from .distance3d import checker3d
 from .robot3d import Robot3D
 from .scene3d import Scene3D
+
+
+@dataclass(frozen=True)
+class Certificate3D(Certificate):
+    """A :class:`gdnplan.ccd.Certificate` of a 3-D path (module docstring).
+
+    When ``ok``: every obstacle and ordinary self pair keeps d > ``margin`` (≥ ``lower_bound``)
+    and every pair of ``contact_only`` keeps d > 0 (≥ ``lower_bound − margin``) on the whole
+    continuous path. ``lower_bound`` and ``min_distance`` bound c(q) = min_k (d_k + o_k).
+
+    Attributes:
+        margin: the clearance proven for obstacle and ordinary self pairs (m).
+        contact_only: the contact-only link pairs ("link1–link2", sorted) proven out of
+            contact, with no margin.
+    """
+
+    margin: float = 0.0
+    contact_only: tuple[str, ...] = ()
+
 
 _ARMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # robot -> its lever arms
 
@@ -109,14 +144,16 @@ def certify_path3d(
     stop_early: bool = False,
 ) -> Certificate:
     """Prove that the piecewise-linear joint path q_path (K, dof) keeps the exact signed
-    distance (obstacles and self-collision) above ``margin`` (m) on the whole continuous path.
+    distance of obstacle and ordinary self pairs above ``margin`` (m) and of contact-only self
+    pairs above 0 on the whole continuous path (module docstring).
 
     ``tol`` (m): also bisect until the reported lower bound is within ``tol`` of the smallest
     checked distance (inf: prove the margin only); ``stop_early``: return at the first
     configuration within the margin. Returns a :class:`gdnplan.ccd.Certificate`; ``ok`` only
     with a proof on every piece (then ``reason`` is ""). ``min_splits`` ≤ ``MAX_SPLITS``; the
     budget ``max_checks`` is never exceeded: initial pieces needing more fail before any coal
-    call (``ok=False``, ``n_checks=0``, the reason; :mod:`gdnplan.ccd`).
+    call (``ok=False``, ``n_checks=0``, the reason; :mod:`gdnplan.ccd`). Returns a
+    :class:`Certificate3D`.
     """
     check_scene(scene, "3d", "gdnplan.certify_path")
     check_number(margin, "margin")
@@ -129,9 +166,9 @@ def certify_path3d(
     if len(q_path) < 2:
         raise InputError("q_path: a path needs at least 2 waypoints")
     checker = checker3d(scene)
-    return certify_by_bisection(
+    cert = certify_by_bisection(
         q_path,
-        lambda q: checker.evaluate(q).distance,
+        lambda q: checker.evaluate(q, contact_offset=margin).distance,
         lambda qa, qb: motion_bound3d(robot, qa, qb),
         margin,
         tol,
@@ -139,3 +176,5 @@ def certify_path3d(
         bool(stop_early),
         max_checks,
     )
+    pairs = tuple(sorted("–".join(sorted(p)) for p in robot.contact_only))
+    return Certificate3D(**vars(cert), margin=float(margin), contact_only=pairs)

@@ -78,7 +78,7 @@ def hold(
     for link in dict.fromkeys(s.link for s in robot.shapes if s.body == body):
         disabled[frozenset((link, HELD_LINK))] = "same body: the gripper holds it"
     info = {**robot.info, "held": name, "tool_frame": frame, "held_placement": tf.copy()}
-    return Robot3D(robot.name, model, shapes, pairs, disabled, info)
+    return Robot3D(robot.name, model, shapes, pairs, disabled, info, robot.contact_only)
 
 
 __all__ = ["HELD_LINK", "hold", "stick"]

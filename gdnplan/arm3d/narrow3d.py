@@ -7,6 +7,18 @@ every enabled self-collision pair (robot shape, robot shape) of
 penetration depth when overlapping), witness points p₁ (on shape 1, the robot's), p₂ (on
 shape 2) and the unit normal n from shape 1 to shape 2, with p₂ − p₁ = d_k n.
 
+Contact-only pairs (:mod:`gdnplan.arm3d.pairs`): :attr:`PairTable.contact_only` marks the self
+pairs that must only stay out of contact. :meth:`PairTable.offsets` gives the per-pair offset
+o_k (m) added to d_k before it is compared with a margin M: o_k = M on contact-only pairs, 0
+elsewhere, so
+
+    min_k (d_k + o_k) ≥ M   ⟺   d_k ≥ M on obstacle and ordinary self pairs, d_k ≥ 0 on
+                                 contact-only pairs.
+
+o_k is a constant: it shifts a pair's value but not how fast it can change along a path (the
+certificate's motion bounds hold unchanged) nor its gradient. An offset of +inf leaves the
+contact-only pairs out; 0 gives the true signed distances.
+
 Broad-phase bounds: every shape has a bounding sphere (centre c, radius r, from coal's local
 AABB), so d_k ≥ b_k = |c₁ − c₂| − r₁ − r₂ (:meth:`PairTable.placements_batch`).
 
@@ -53,6 +65,7 @@ class PairTable:
         self.pair_a = np.concatenate([obs[:, 0], robot.self_pairs[:, 0]]).astype(int)
         self.pair_b = np.concatenate([obs[:, 1], robot.self_pairs[:, 1]]).astype(int)
         self.is_self = np.r_[np.zeros(len(obs), bool), np.ones(len(robot.self_pairs), bool)]
+        self.contact_only = np.r_[np.zeros(len(obs), bool), robot.self_contact_only].astype(bool)
         self.link_a = robot.shape_link[self.pair_a]
         self.n_obstacle_pairs = len(obs)  # pairs [0, n_obstacle_pairs) are obstacle pairs
         self_b = robot.self_pairs[:, 1]
@@ -98,6 +111,12 @@ class PairTable:
             other = f"{shapes[b].link}/{shapes[b].name}" if s else obstacles[b].name
             out.append((f"{shapes[a].link}/{shapes[a].name}", other))
         return out
+
+    def offsets(self, contact_offset: float) -> np.ndarray:
+        """(P,) offsets o_k (m): ``contact_offset`` on contact-only pairs, 0 on the others
+        (module docstring; pass the margin M to compare min_k (d_k + o_k) with M)."""
+        value = check_offset(contact_offset)
+        return np.where(self.contact_only, value, 0.0)
 
     # ------------------------------------------------------------------ one configuration
     def placements(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -179,4 +198,18 @@ def check_cap(cap) -> float:
     return value
 
 
-__all__ = ["PairTable", "check_cap"]
+def check_offset(contact_offset) -> float:
+    """``contact_offset`` as a float (m; +inf allowed), InputError for NaN, −inf or a non-number."""
+    bad = InputError(f"contact_offset: expected a number (m) or inf, got {contact_offset!r}")
+    if isinstance(contact_offset, bool):
+        raise bad
+    try:
+        value = float(contact_offset)
+    except (TypeError, ValueError) as e:
+        raise bad from e
+    if np.isnan(value) or value == -np.inf:
+        raise bad
+    return value
+
+
+__all__ = ["PairTable", "check_cap", "check_offset"]

@@ -1,6 +1,8 @@
-"""Self-collision pairs of a 3-D robot: which link pairs are checked, and why the others are not.
+"""Self-collision pairs of a 3-D robot: which link pairs are checked, how, and why.
 
-A pair of links (each carrying collision shapes) is checked unless
+Every pair of links (each carrying collision shapes) falls in one of three kinds.
+
+**Unchecked** (``robot.disabled`` keeps the reason), never evaluated:
 
 * ``"same body"``: both move with the same planning joint (they are rigidly attached, e.g. a
   wrist, its flange and a locked gripper): their distance never changes;
@@ -10,12 +12,28 @@ A pair of links (each carrying collision shapes) is checked unless
   remove. A locked joint on the way keeps a pair checked: with a UR5e's wrist joints locked the
   gripper shares the forearm's body, yet it can fold into the upper arm;
 * the SRDF, when one is given, disables it (``<disable_collisions link1= link2= reason=/>``:
-  MoveIt's "Adjacent", "Never", "Default", "Always"); the reason is kept.
+  MoveIt's "Adjacent", "Never", "Default", "Always"); the reason is kept. An SRDF pair must
+  truly never come close: gdnplan does not look at it again.
 
-Without an SRDF only the first two rules apply. The shipped UR5e has one
-(``shipped/robots/ur5e.srdf``): without it, pairs such as the forearm against the wrist-2
-housing stay within 1.5 cm of each other at every configuration and would pin the overall
-minimum distance to that gap. Every shape of one link is paired with every shape of the other.
+**Contact-only** (``robot.contact_only``): checked for contact only, signed distance d ≥ 0
+whatever the clearance margin. These are pairs that can collide but whose geometry keeps them
+closer than any useful margin at every configuration: the shipped UR5e's forearm against the
+wrist-2 housing (d ≤ 1.45 cm everywhere, down to −2.0 cm) and against wrist 3 (down to
+−1.5 cm). Disabling them would be unsound (the cylinders do interpenetrate); giving them the
+margin (default 2 cm) would make every configuration infeasible. Users declare their own with
+``robot3d_from_urdf(..., contact_only=[(link1, link2), ...])``.
+
+**Ordinary**: every other pair, which must keep the clearance margin like an obstacle pair.
+
+The pair table (:mod:`gdnplan.arm3d.narrow3d`) compares d_k + o_k with the margin M, with the
+offset o_k = M on contact-only pairs and 0 elsewhere, so min_k (d_k + o_k) ≥ M ⟺ obstacle and
+ordinary pairs ≥ M and contact-only pairs ≥ 0. A certificate (:mod:`gdnplan.arm3d.ccd3d`)
+proves exactly that on the whole continuous path. :func:`gdnplan.arm3d.signed_distance3d`
+returns true signed distances (no offsets) over all checked pairs, contact-only ones included.
+
+Without an SRDF only the first two rules disable pairs. The shipped UR5e has one
+(``shipped/robots/ur5e.srdf``) and declares its contact-only pairs in
+:mod:`gdnplan.arm3d.builtin`. Every shape of one link is paired with every shape of the other.
 """
 
 from __future__ import annotations
@@ -58,9 +76,14 @@ def srdf_disabled_pairs(srdf: str | Path, model: pin.Model) -> dict[frozenset[st
 
 
 def self_collision_pairs(
-    full: pin.Model, reduced: pin.Model, shapes: Sequence, srdf: str | Path | None
-) -> tuple[np.ndarray, dict[frozenset[str], str]]:
-    """Shape index pairs (P, 2) to check, and every unchecked link pair → its reason.
+    full: pin.Model,
+    reduced: pin.Model,
+    shapes: Sequence,
+    srdf: str | Path | None,
+    contact_only: Sequence[tuple[str, str]] = (),
+) -> tuple[np.ndarray, dict[frozenset[str], str], frozenset[frozenset[str]]]:
+    """Shape index pairs (P, 2) to check, every unchecked link pair → its reason, and the
+    checked link pairs that are contact-only (:func:`check_contact_only`).
 
     ``shapes`` carry ``link`` (URDF link name) and ``body`` (reduced joint index).
     """
@@ -85,7 +108,44 @@ def self_collision_pairs(
         if shapes[i].link != shapes[j].link
         and frozenset((shapes[i].link, shapes[j].link)) not in disabled
     ]
-    return np.array(pairs, dtype=int).reshape(-1, 2), disabled
+    contact = check_contact_only(contact_only, tuple(body), disabled)
+    return np.array(pairs, dtype=int).reshape(-1, 2), disabled, contact
+
+
+def check_contact_only(
+    contact_only, links: Sequence[str], disabled: dict[frozenset[str], str]
+) -> frozenset[frozenset[str]]:
+    """The declared contact-only link pairs as a set of frozensets.
+
+    InputError for anything but a sequence of (link, link) name pairs, a link without
+    collision shapes (or not in the robot), a link paired with itself, or a pair that is not
+    checked at all (same body, adjacent, disabled by the SRDF: the reason is named).
+    """
+    if isinstance(contact_only, (str, bytes)) or not isinstance(contact_only, (list, tuple)):
+        raise InputError(
+            f"contact_only: expected a list of (link, link) pairs, got {contact_only!r}"
+        )
+    out: set[frozenset[str]] = set()
+    for k, item in enumerate(contact_only):
+        where = f"contact_only[{k}]"
+        if not (isinstance(item, (list, tuple)) and len(item) == 2):
+            raise InputError(f"{where}: expected a pair of link names, got {item!r}")
+        for link in item:
+            if not isinstance(link, str) or link not in links:
+                raise InputError(
+                    f"{where}: {link!r} is not a link with collision shapes; choose from "
+                    f"{list(links)}"
+                )
+        key = frozenset(item)
+        if len(key) != 2:
+            raise InputError(f"{where}: a link cannot be paired with itself ({item[0]!r})")
+        if key in disabled:
+            raise InputError(
+                f"{where}: {item[0]!r}–{item[1]!r} is not checked at all ({disabled[key]}); "
+                "only a checked pair can be contact-only (remove it from the SRDF first)"
+            )
+        out.add(key)
+    return frozenset(out)
 
 
 def _adjacent(full: pin.Model, reduced: pin.Model, a: str, b: str, ba: int, bb: int) -> bool:
@@ -100,5 +160,20 @@ def _adjacent(full: pin.Model, reduced: pin.Model, a: str, b: str, ba: int, bb: 
 
 
 def checked_link_pairs(robot) -> set[frozenset[str]]:
-    """The link pairs a robot checks for self-collision (from its shape pairs)."""
+    """The link pairs a robot checks for self-collision (from its shape pairs), contact-only
+    pairs included."""
     return {frozenset((robot.shapes[i].link, robot.shapes[j].link)) for i, j in robot.self_pairs}
+
+
+def contact_only_mask(shapes: Sequence, self_pairs: np.ndarray, contact_only) -> np.ndarray:
+    """(P,) bool: the shape pairs ``self_pairs`` (P, 2) whose link pair is contact-only.
+
+    InputError when a contact-only link pair has no shape pair among ``self_pairs``.
+    """
+    keys = [frozenset((shapes[i].link, shapes[j].link)) for i, j in self_pairs]
+    mask = np.array([k in contact_only for k in keys], dtype=bool)
+    missing = set(contact_only) - set(keys)
+    if missing:
+        names = sorted("–".join(sorted(p)) for p in missing)
+        raise InputError(f"contact_only: {names} are not checked self-collision pairs")
+    return mask

@@ -32,7 +32,7 @@ from ..urdf_robot import RobotSpec, load_urdf
 from ..urdf_robot.joint_limits import check_joint_limits
 from ..urdf_robot.load import check_mimic
 from ..urdf_robot.locking import lock_mimics, set_locked
-from .pairs import self_collision_pairs
+from .pairs import contact_only_mask, self_collision_pairs
 from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
 
 
@@ -66,6 +66,10 @@ class Robot3D:
         shapes: every link shape; links: names of the links with shapes (the per-link order).
         shape_link: (S,) index into ``links`` of each shape.
         self_pairs: (P, 2) shape indices of the self-collision pairs checked.
+        contact_only: the link pairs (frozensets of two names) checked for contact only
+            (signed distance ≥ 0, never the clearance margin; :mod:`gdnplan.arm3d.pairs`).
+        self_contact_only: (P,) bool, True for the rows of ``self_pairs`` on those links.
+        disabled: every unchecked link pair → its reason.
         lower, upper: (dof,) joint limits (rad).
     """
 
@@ -77,6 +81,7 @@ class Robot3D:
         self_pairs: np.ndarray,
         disabled: dict[frozenset[str], str],
         info: dict | None = None,
+        contact_only=frozenset(),
     ):
         self.name = name
         self.model = model
@@ -87,6 +92,8 @@ class Robot3D:
         self.shape_body = np.array([s.body for s in self.shapes], dtype=int)
         self.self_pairs = np.asarray(self_pairs, dtype=int).reshape(-1, 2)
         self.disabled = dict(disabled)
+        self.contact_only = frozenset(frozenset(p) for p in contact_only)
+        self.self_contact_only = contact_only_mask(self.shapes, self.self_pairs, self.contact_only)
         self.lower = model.lowerPositionLimit.copy()
         self.upper = model.upperPositionLimit.copy()
         self.info = dict(info or {})
@@ -162,6 +169,7 @@ def robot3d_from_urdf(
     locked: dict[str, float] | None = None,
     srdf: str | Path | None = None,
     name: str | None = None,
+    contact_only: Sequence[tuple[str, str]] = (),
 ) -> Robot3D:
     """A 3-D robot from a URDF file (and optionally its SRDF for disabled collision pairs).
 
@@ -176,6 +184,11 @@ def robot3d_from_urdf(
         srdf: an SRDF whose ``disable_collisions`` pairs are not checked for self-collision
             (see :func:`gdnplan.arm3d.pairs.self_collision_pairs`).
         name: the robot's name (default: the URDF's stem).
+        contact_only: link pairs (link1, link2) checked for contact only: their signed
+            distance must stay ≥ 0 whatever the clearance margin (pairs whose geometry keeps
+            them within any useful margin but which can still collide;
+            :mod:`gdnplan.arm3d.pairs`). Each must be a checked pair of two links with shapes
+            (not same-body, adjacent or SRDF-disabled), else InputError.
 
     Raises:
         UnknownNameError: a missing URDF, mesh, SRDF, or an unknown joint name.
@@ -209,8 +222,9 @@ def robot3d_from_urdf(
             f"urdf: {path.name} has no collision geometry (<visual> elements are not read); "
             "add <collision> shapes"
         )
-    pairs, disabled = self_collision_pairs(model, reduced, shapes, srdf)
-    return Robot3D(name or path.stem, reduced, shapes, pairs, disabled, {"urdf": str(path)})
+    pairs, disabled, contact = self_collision_pairs(model, reduced, shapes, srdf, contact_only)
+    info = {"urdf": str(path)}
+    return Robot3D(name or path.stem, reduced, shapes, pairs, disabled, info, contact)
 
 
 def _check_joints(model: pin.Model, planning: list[str], movable: list[str], source: str) -> None:

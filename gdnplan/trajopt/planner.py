@@ -38,7 +38,9 @@ def resolve_model(
     """The DistanceModel named by ``collision`` ("coal", "graphdistnet" or a model instance).
 
     "coal" is the scene kind's exact model: :class:`~gdnplan.models.CoalModel` for a planar
-    scene, :class:`~gdnplan.arm3d.Coal3DModel` for a 3-D one.
+    scene, :class:`~gdnplan.arm3d.Coal3DModel` for a 3-D one (:func:`plan` gives it the
+    problem's margin as contact offset: the rows then keep contact-only self pairs at d ≥ 0
+    and every other pair at the margin).
 
     ``weights`` (GraphDistNet): shipped weights by name (``"d"``, ``"ur5e_boxes3d_preliminary"``)
     or a ``.safetensors`` path; None picks the shipped weights for a planar scene's robot and
@@ -125,6 +127,8 @@ def plan(
     if max_acceleration is not None:
         max_acceleration = limit_vector(max_acceleration, dof, "max_acceleration", "rad/s²")
     model = resolve_model(collision, problem.scene, weights)
+    if isinstance(model, Coal3DModel):  # contact-only pairs: rows d + margin ≥ bound ≥ margin
+        model = Coal3DModel(contact_offset=problem.margin)
     goal = problem.goal
     if goal is None:  # the joint goal of goal_position: the step bound must still reach it
         goal = numeric_ik(problem, seed)

@@ -187,11 +187,12 @@ class Problem:
                     f"{name}[{j}] = {q[j]:.4g} is outside the joint limits "
                     f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
                 )
-            d = float(exact_distance(self.scene, q)[0])
+            d = float(exact_distance(self.scene, q, margin=self.margin)[0])
             if d <= self.margin or proven_distance(d) <= self.certified_clearance:
                 raise InfeasibleProblemError(
                     f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m between "
-                    f"{closest_pair(self.scene, q)}; move it away or lower options.margin"
+                    f"{closest_pair(self.scene, q, margin=self.margin)}; move it away or lower "
+                    "options.margin"
                 )
         if self.goal is not None and isinstance(self.scene, Scene):
             blocked = first_joint_barrier(self.scene, self.start[0], self.goal[0])
