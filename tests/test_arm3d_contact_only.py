@@ -182,3 +182,25 @@ def test_a_user_robot_declares_its_own_contact_only_pairs():
     )
     assert robot.contact_only == {frozenset(("wrist_1_link", "wrist_3_link"))}
     assert robot.self_contact_only.sum() >= 1
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        "problems/fetch3d/fetch3d_approach.toml",
+        "problems/fetch3d/fetch3d_reach_in.toml",
+        "problems/fetch3d/fetch3d_bring_out.toml",
+        "problems/ur5e_boxes3d.toml",  # margin 0.02, a real solve (about a minute)
+    ],
+)
+def test_shipped_ur5e_problems_still_plan_and_certify(path):
+    problem = Problem.from_toml(path)
+    result = plan(problem)
+    assert result.success, result.reason
+    scene = problem.scene
+    assert certify_path3d(scene, result.q, problem.certified_clearance).ok
+    s = np.linspace(0.0, 1.0, 50)[:, None]
+    dense = np.concatenate([a + s * (b - a) for a, b in itertools.pairwise(result.q)])
+    pairs, _ = checker3d(scene).pair_distances(dense)
+    contact = checker3d(scene).contact_only
+    assert contact.any() and pairs[:, contact].min() >= 0.0  # contact-only pairs: d ≥ 0

@@ -9,6 +9,7 @@ from gdnplan.arm3d import (
     Scene3D,
     box_obstacle,
     certify_path3d,
+    checker3d,
     load_robot3d,
     signed_distance3d,
 )
@@ -24,6 +25,12 @@ GOAL = np.array([0.6, -1.2, 1.2, -1.5, -1.57, 0.0])
 def wall() -> Scene3D:
     """The UR5e in front of a thin post the straight line from START to GOAL passes through."""
     return Scene3D(load_robot3d("ur5e"), [box_obstacle((0.1, 0.1, 0.6), (0.45, 0.0, 0.3))])
+
+
+def clearance(scene: Scene3D, q: np.ndarray, margin: float) -> np.ndarray:
+    """min_k (d_k + o_k) (m): what a margin is compared with (contact-only self pairs need
+    d ≥ 0 only: offset o_k = margin; gdnplan.arm3d.pairs)."""
+    return checker3d(scene).evaluate(q, contact_offset=margin).distance
 
 
 def line(n: int = 50) -> np.ndarray:
@@ -49,7 +56,8 @@ def test_a_3d_plan_is_certified_along_the_whole_path():
             for a, b in zip(result.q[:-1], result.q[1:], strict=True)
         ]
     )
-    assert np.min(signed_distance3d(problem.scene, dense)) > problem.margin
+    assert np.min(clearance(problem.scene, dense, problem.margin)) > problem.margin
+    assert np.min(signed_distance3d(problem.scene, dense)) > 0  # contact-only pairs too
     assert result.trajectory is not None and result.trajectory.kind == "linear"
 
 
@@ -67,9 +75,10 @@ def test_a_path_just_inside_the_clearance_is_refused():
     """Clearance is a promise in 3-D too: a collision-free path closer than the margin (the
     post moved back: the line passes 3.6 cm from it, the ends 5.5 cm) is no success."""
     scene = Scene3D(load_robot3d("ur5e"), [box_obstacle((0.1, 0.1, 0.6), (0.8, 0.0, 0.3))])
-    d_line = float(np.min(signed_distance3d(scene, line(200))))
     margin = 0.045
-    assert 0 < d_line < margin < float(np.min(signed_distance3d(scene, np.stack([START, GOAL]))))
+    d_line = float(np.min(clearance(scene, line(200), margin)))
+    ends = float(np.min(clearance(scene, np.stack([START, GOAL]), margin)))
+    assert 0 < d_line < margin < ends
     problem = Problem(scene, START, goal=GOAL, waypoints=10, margin=margin)
     result = _finish(problem, _Run(q=line(10)), 0.0)
     assert not result.success and "coal certificate of clearance > 0.045 m failed" in result.reason
@@ -87,7 +96,8 @@ def test_adam_and_acceleration_limits_run_on_a_3d_scene():
     assert curve.kind == "smooth"  # the curve certificate works in 3-D (self-collision too)
     assert curve.min_distance is not None and curve.min_distance > 0
     _, q = curve.sample(curve.duration / 200)
-    assert signed_distance3d(free.scene, q).min() >= curve.min_distance - 1e-9
+    assert clearance(free.scene, q, 0.02).min() >= curve.min_distance - 1e-9
+    assert signed_distance3d(free.scene, q).min() > 0  # contact-only pairs: d > 0
 
 
 def test_coal_is_the_3d_model_and_learned_3d_weights_must_be_named():
