@@ -19,8 +19,10 @@ retreat      q_out → q_home          holding   planned
 Planned stages use ``margin`` (m) as their clearance: a planned stage succeeds when the coal
 certificate of :func:`gdnplan.ccd.certify_path` proves d > margin on the whole continuous path
 (:attr:`gdnplan.trajopt.Plan.success`). The
-lift is certified from its first point off the shelf (tcp ≥ 1 mm above it): its start is the
-contact the grasp makes by design.
+lift is certified from its second point on (tcp 2 mm above the shelf, ``certified_from`` = 1):
+its start is the contact the grasp makes by design (d = 0), where no certificate can prove a
+clearance; its ``min_distance`` is the true minimum over its whole path (0 at that contact),
+``certified_min_distance`` the proven lower bound over the certified rows.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ log = logging.getLogger(__name__)  # one INFO line per finished stage
 
 STAGES = ("approach", "reach_in", "grasp", "lift", "bring_out", "retreat")
 LIFT_POINTS = 11  # IK points on the lift line, 2 mm apart
+CONTACT_SAMPLES = 50  # coal distances on the lift's first (uncertified) segment
 # the closed gripper's stick rests on its shelf (d = 0 by construction); coal's rounding gives
 # up to ≈ −4e-16 m there on some layouts, which is contact, not penetration
 RESTING_CONTACT_TOL = 1e-9  # m
@@ -85,8 +88,15 @@ class Stage:
         q: (T, 3) joint path (rad); a single configuration repeated for ``grasp``.
         success: certified collision-free (planned stages: :class:`~gdnplan.trajopt.Plan`'s
             success; grasp: the closed gripper holds the stick; lift: certified off the shelf).
-        min_distance: proven lower bound on the coal distance along the stage's path (m; −inf
-            when the certificate could not prove it); grasp: coal's distance at the grasp.
+        min_distance: the smallest coal distance along the stage's whole path q (m): the
+            certificate's proven lower bound when it covers all of q (planned stages; −inf when
+            it could not prove one); grasp: coal's distance at the grasp; lift: the smaller of
+            coal's distance along its uncertified first segment (sampled; 0 at the resting
+            contact) and the proven bound over the rest.
+        certified_from: the first row of q the continuous certificate covers (0: all of it;
+            lift: 1), None when there is no certificate (grasp: one configuration).
+        certified_min_distance: the certificate's proven lower bound over q[certified_from:]
+            (m; None: min_distance when certified_from is 0).
         solve_time: wall time of the stage (s).
         planned: True when solved by :func:`~gdnplan.trajopt.plan`.
         detail: the planner's reason, or what a scripted stage did.
@@ -104,14 +114,22 @@ class Stage:
     planned: bool
     detail: str
     times: np.ndarray | None = None
+    certified_from: int | None = 0
+    certified_min_distance: float | None = None
 
     def summary(self) -> dict:
-        """JSON-ready summary (q as lists, t the times of its rows or null)."""
+        """JSON-ready summary (q as lists, t the times of its rows or null); non-finite
+        distances are null."""
+        proven = self.certified_min_distance
+        if proven is None and self.certified_from == 0:
+            proven = self.min_distance
         return {
             "stage": self.name,
             "gripper": self.scene.robot.info["gripper"],
             "success": bool(self.success),
-            "min_distance": float(self.min_distance) if np.isfinite(self.min_distance) else None,
+            "min_distance": _json_distance(self.min_distance),
+            "certified_from": self.certified_from,
+            "certified_min_distance": None if proven is None else _json_distance(proven),
             "solve_time": float(self.solve_time),
             "planned": self.planned,
             "detail": self.detail,
@@ -119,6 +137,10 @@ class Stage:
             "q": np.asarray(self.q).tolist(),
             "t": None if self.times is None else np.asarray(self.times).tolist(),
         }
+
+
+def _json_distance(d: float) -> float | None:
+    return float(d) if np.isfinite(d) else None
 
 
 def fetch_scenes(seed: int = 0) -> dict[str, Scene]:
@@ -156,6 +178,27 @@ def lift_path(scene: Scene, n: int = LIFT_POINTS) -> np.ndarray:
             raise InfeasibleProblemError(f"lift: no IK solution {k * LIFT / (n - 1):.3f} m up")
         path.append(min(candidates, key=lambda q: float(np.abs(q - path[-1]).sum())))
     return np.array(path)
+
+
+def _lift(held: Scene) -> Stage:
+    """The scripted lift: rows 1… certified (proven > 0), row 0 the resting contact (coal
+    d ≥ −RESTING_CONTACT_TOL); min_distance the minimum over the whole path."""
+    t0 = time.perf_counter()
+    path = lift_path(held)
+    ok, proven = verify_path(held, path[1:])
+    s = np.linspace(0.0, 1.0, CONTACT_SAMPLES)[:, None]
+    first = float(signed_distance(held, path[0] + s * (path[1] - path[0])).min())
+    ok = ok and first >= -RESTING_CONTACT_TOL
+    up = 1000 * LIFT / (LIFT_POINTS - 1)
+    detail = (
+        f"scripted vertical lift of {LIFT} m; rows 1… ({up:.0f} mm up and above) certified, "
+        f"proven d ≥ {proven:.4g} m; row 0 is the stick resting on its shelf (coal d = "
+        f"{float(signed_distance(held, path[0])[0]):.3g} m), the first segment "
+        f"{CONTACT_SAMPLES} coal samples, min {first:.3g} m"
+    )
+    times = _scripted_times(held, path)
+    dt = time.perf_counter() - t0
+    return Stage("lift", held, path, ok, min(first, proven), dt, False, detail, times, 1, proven)
 
 
 def _planned(
@@ -218,26 +261,11 @@ def run_fetch(
                     f"{held.robot.info['stick_width']:.3f} m stick; it rests on its shelf "
                     f"(d = {d:.4f} m)",
                     _scripted_times(held, at_grasp),
+                    None,
                 )
             )
         elif name == "lift":
-            t0 = time.perf_counter()
-            path = lift_path(held)
-            ok, dmin = verify_path(held, path[1:])
-            out.append(
-                Stage(
-                    name,
-                    held,
-                    path,
-                    ok,
-                    dmin,
-                    time.perf_counter() - t0,
-                    False,
-                    f"scripted vertical lift of {LIFT} m; certified from "
-                    f"{1000 * LIFT / (LIFT_POINTS - 1):.0f} mm above the shelf",
-                    _scripted_times(held, path),
-                )
-            )
+            out.append(_lift(held))
         elif name == "bring_out":
             problem = stage_problem(
                 held, info["q_lift"], info["q_out"], margin, solver=bring_out_config()

@@ -8,7 +8,7 @@ import itertools
 import numpy as np
 import pytest
 
-from gdnplan.arm3d import certify_path3d
+from gdnplan.arm3d import certify_path3d, checker3d
 from gdnplan.arm3d.fetch3d import PLANNED, STAGES, knots, run_fetch3d, stage_problems
 from gdnplan.arm3d.fetch3d_scene import fetch3d
 from gdnplan.errors import InputError
@@ -31,9 +31,29 @@ def test_the_approach_is_planned_and_its_path_certified(canonical):
 def test_grasp_and_lift_are_scripted_and_certified(canonical):
     grasp, lift = run_fetch3d(fetch=canonical, stages=("grasp", "lift"))
     assert grasp.success and not grasp.planned and abs(grasp.min_distance) < 1e-6
-    assert lift.success and lift.min_distance > 0
+    assert lift.success and abs(lift.min_distance) <= 1e-9  # it starts resting on the shelf
+    assert lift.certified_from == 1 and lift.certified_min_distance > 0
     assert np.allclose(lift.q[0], canonical.q["q_grasp"])
     assert np.allclose(lift.q[-1], canonical.q["q_lift"])
+
+
+def test_the_lifts_min_distance_is_the_minimum_over_its_whole_path(canonical):
+    """min_distance means what it says: coal's minimum along all of q (0: the stick rests on
+    its shelf at q[0]); the certified part and its proven bound are reported apart."""
+    (lift,) = run_fetch3d(fetch=canonical, stages=("lift",))
+    scene = lift.scene
+    s = np.linspace(0.0, 1.0, 40)[:, None]
+    dense = np.vstack([a + s * (b - a) for a, b in itertools.pairwise(lift.q)])
+    coal = checker3d(scene).evaluate(dense).distance
+    assert lift.min_distance == pytest.approx(coal.min(), abs=1e-9)
+    assert certify_path3d(scene, lift.q[lift.certified_from :], 0.0).lower_bound == pytest.approx(
+        lift.certified_min_distance
+    )
+    summary = lift.summary()
+    assert summary["min_distance"] == pytest.approx(coal.min(), abs=1e-9)
+    assert summary["certified_from"] == 1
+    assert summary["certified_min_distance"] == lift.certified_min_distance
+    assert coal[40:].min() >= lift.certified_min_distance  # the bound holds where it is claimed
 
 
 def test_stages_along_tool_lines_are_planned_in_pieces_between_knots(canonical):

@@ -88,3 +88,20 @@ def test_grasp_accepts_the_stick_resting_on_its_shelf(seed):
 def test_unknown_stage_is_bad_input():
     with pytest.raises(gp.InputError):
         run_fetch(0, collision="coal", stages=("dance",))
+
+
+@pytest.mark.parametrize("seed", [0, 2])
+def test_the_lifts_min_distance_is_the_minimum_over_its_whole_path(seed):
+    """min_distance is coal's minimum along the whole lift (0: the stick rests on its shelf at
+    q[0]); certified_from and certified_min_distance say what the certificate proved."""
+    (lift,) = run_fetch(seed, collision="coal", stages=("lift",))
+    s = np.linspace(0.0, 1.0, 40)[:, None]
+    dense = np.vstack([a + s * (b - a) for a, b in zip(lift.q[:-1], lift.q[1:], strict=True)])
+    coal = gp.signed_distance(lift.scene, dense)
+    assert lift.success and abs(lift.min_distance) <= RESTING_CONTACT_TOL
+    assert lift.min_distance == pytest.approx(coal.min(), abs=1e-9)
+    summary = lift.summary()
+    assert summary["certified_from"] == 1 and summary["certified_min_distance"] > 0
+    assert coal[40:].min() >= summary["certified_min_distance"]
+    grasp = run_fetch(seed, collision="coal", stages=("grasp",))[0].summary()
+    assert grasp["certified_from"] is None and grasp["certified_min_distance"] is None

@@ -14,7 +14,7 @@ grasp        q_grasp                 holding   the fingers close on the stick, w
                                                its shelf (d = 0 by construction)
 lift         q_grasp → q_lift        holding   scripted: the tcp rises LIFT = 0.02 m on a
                                                straight line (pose IK), certified from its
-                                               first point off the shelf (2 mm up)
+                                               second point on (2 mm up, certified_from 1)
 bring_out    q_lift → q_out          holding   planned, the stick back out through the
                                                entrance, piece by piece between knots
 retreat      q_out → q_home          holding   planned
@@ -24,7 +24,10 @@ Planned stages are :class:`gdnplan.trajopt.Problem` s on the stage's Scene3D wit
 ``margin`` (m) and coal's exact distance (:func:`stage_problems`); a piece succeeds when the
 coal certificate (:func:`gdnplan.arm3d.certify_path3d`) proves d > margin on its whole
 continuous path (obstacles and self-collision, the held stick included), a stage when every
-piece does (the pieces share their ends, so the stage's path is certified).
+piece does (the pieces share their ends, so the stage's path is certified). The lift starts at
+the stick's resting contact (d = 0), where no certificate proves a clearance: its
+``min_distance`` is the true minimum over its whole path (0 there), ``certified_min_distance``
+the proven lower bound over rows ``certified_from`` = 1 on.
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ PLANNED = {  # stage → (scene, start, goal)
     "retreat": ("holding", "q_out", "q_home"),
 }
 RESTING_CONTACT_TOL = 1e-9  # m: the stick on its shelf is contact, not penetration
+CONTACT_SAMPLES = 50  # coal distances on the lift's first (uncertified) segment
 WAYPOINTS = 30
 KNOT_STEP = 10  # points of a straight tool line (LINE_STEP = 0.01 m apart) between knots
 MARGIN = 0.01  # m: clearance of the planned stages
@@ -77,10 +81,17 @@ class Stage3D:
         q: (T, 6) joint path (rad); grasp: q_grasp twice.
         success: certified (planned: the plan's certificate; grasp: the stick rests on its
             shelf without penetration; lift: certified off the shelf).
-        min_distance: proven lower bound of the coal distance along the path (m; −inf when
-            none was proven); grasp: coal's distance at q_grasp.
+        min_distance: the smallest coal distance along the whole path q (m): the proven lower
+            bound when the certificate covers all of q (planned; −inf when none was proven);
+            grasp: coal's distance at q_grasp; lift: the smaller of coal's distance along its
+            uncertified first segment (sampled; 0 at the resting contact) and the proven bound
+            over the rest.
         solve_time: wall time of the stage (s). planned: solved by :func:`plan`.
         detail: the planner's reason or what the scripted stage did.
+        certified_from: the first row of q the certificate covers (0: all; lift: 1), None
+            without a certificate (grasp).
+        certified_min_distance: the proven lower bound over q[certified_from:] (m; None:
+            min_distance when certified_from is 0).
     """
 
     name: str
@@ -92,20 +103,31 @@ class Stage3D:
     solve_time: float
     planned: bool
     detail: str
+    certified_from: int | None = 0
+    certified_min_distance: float | None = None
 
     def summary(self) -> dict:
-        """JSON-ready summary (q as lists)."""
+        """JSON-ready summary (q as lists; non-finite distances null)."""
+        proven = self.certified_min_distance
+        if proven is None and self.certified_from == 0:
+            proven = self.min_distance
         return {
             "stage": self.name,
             "gripper": self.gripper,
             "success": bool(self.success),
-            "min_distance": float(self.min_distance) if np.isfinite(self.min_distance) else None,
+            "min_distance": _json_distance(self.min_distance),
+            "certified_from": self.certified_from,
+            "certified_min_distance": None if proven is None else _json_distance(proven),
             "solve_time": float(self.solve_time),
             "planned": self.planned,
             "detail": self.detail,
             "joint_names": list(self.scene.robot.joint_names),
             "q": np.asarray(self.q).tolist(),
         }
+
+
+def _json_distance(d: float) -> float | None:
+    return float(d) if np.isfinite(d) else None
 
 
 def knots(fetch: Fetch3D, name: str) -> list[np.ndarray]:
@@ -171,17 +193,27 @@ def _grasp(fetch: Fetch3D) -> Stage3D:
     )
     q = np.array([fetch.q["q_grasp"]] * 2)
     ok = d >= -RESTING_CONTACT_TOL
-    return Stage3D("grasp", "holding", scene, q, ok, d, time.perf_counter() - t0, False, detail)
+    dt = time.perf_counter() - t0
+    return Stage3D("grasp", "holding", scene, q, ok, d, dt, False, detail, None)
 
 
 def _lift(fetch: Fetch3D) -> Stage3D:
     t0 = time.perf_counter()
     scene, path = fetch.scenes["holding"], fetch.lines["lift"]
     cert = certify_path3d(scene, path[1:], margin=0.0)
-    detail = f"scripted straight lift, certified from {1000 * LIFT / (len(path) - 1):.0f} mm up"
     lower = cert.lower_bound if cert.ok else -np.inf
+    s = np.linspace(0.0, 1.0, CONTACT_SAMPLES)[:, None]
+    first = checker3d(scene).evaluate(path[0] + s * (path[1] - path[0])).distance
+    ok = cert.ok and float(first.min()) >= -RESTING_CONTACT_TOL
+    detail = (
+        f"scripted straight lift; rows 1… ({1000 * LIFT / (len(path) - 1):.0f} mm up and above) "
+        f"certified, proven d ≥ {lower:.4g} m; row 0 is the stick resting on its shelf (coal "
+        f"d = {first[0]:.3g} m), the first segment {CONTACT_SAMPLES} coal samples, min "
+        f"{first.min():.3g} m"
+    )
     dt = time.perf_counter() - t0
-    return Stage3D("lift", "holding", scene, path, cert.ok, lower, dt, False, detail)
+    low = min(float(first.min()), lower)
+    return Stage3D("lift", "holding", scene, path, ok, low, dt, False, detail, 1, lower)
 
 
 def run_fetch3d(
