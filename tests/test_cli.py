@@ -390,3 +390,18 @@ def test_an_old_solver_table_warns_its_author_in_one_line_and_still_plans(tmp_pa
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr.splitlines() == [warning + "rrt_time → [seed] rrt_time"]
     assert json.loads(proc.stdout)["success"] is True  # stdout stays one JSON object
+
+
+def test_fetch_stage_lines_state_what_each_certificate_proves():
+    """A planned stage: its proven clearance; the lift (certified from its second waypoint):
+    the bound from there and the distance before it, not a bound it does not prove."""
+    from types import SimpleNamespace
+
+    from gdnplan.cli.plan import stage_clearance
+
+    planned = SimpleNamespace(certified_from=0, min_distance=0.0123, certified_min_distance=None)
+    assert stage_clearance(planned) == "certified clearance ≥ +0.0123 m"
+    lift = SimpleNamespace(certified_from=1, min_distance=0.0, certified_min_distance=0.00171)
+    text = stage_clearance(lift)
+    assert text.startswith("certified clearance ≥ +0.0017 m from waypoint 1 on")
+    assert "+0.0000 m before it" in text

@@ -229,11 +229,21 @@ def echo_stages(stages, grippers) -> float:
     for s, gripper in zip(stages, grippers, strict=True):
         how = "planned" if s.planned else "scripted"
         verdict = "certified" if s.success else f"FAILED ({s.detail})"
-        typer.echo(
-            f"{s.name:<10} {gripper:<8} {how:<8} {verdict}; "
-            f"{clearance_text(s.min_distance)}, {s.solve_time:.2f} s"
-        )
+        typer.echo(f"{s.name:<10} {gripper:<8} {how:<8} {verdict}; {stage_clearance(s)}, "
+                   f"{s.solve_time:.2f} s")  # fmt: skip
     return sum(s.solve_time for s in stages)
+
+
+def stage_clearance(stage) -> str:
+    """The clearance a fetch stage proves: over its whole path, or (the lift) from the row
+    its certificate starts at, with the distance before it."""
+    start = getattr(stage, "certified_from", 0)
+    if not start:
+        return clearance_text(stage.min_distance)
+    return (
+        f"{clearance_text(stage.certified_min_distance)} from waypoint {start} on "
+        f"(distance {stage.min_distance:+.4f} m before it)"
+    )
 
 
 def timing_text(traj) -> str:
