@@ -34,3 +34,13 @@ def test_3d_models_refuse_other_scenes(scene):
     for entry in entries(model):
         with pytest.raises(InputError, match="scene"):
             entry(scene, np.zeros(6))
+
+
+@pytest.mark.parametrize("scene", [*WRONG, SPACE])
+def test_diffco_refuses_other_scenes(scene):
+    from gdnplan.models.diffco import DiffCo
+
+    model = DiffCo.train(gp.make_scene("a"), n=60, seed=0, max_iter=200)
+    for entry in entries(model):
+        with pytest.raises(InputError, match="scene"):
+            entry(scene, np.zeros(2))

@@ -40,7 +40,7 @@ import numpy as np
 
 from ..distance import signed_distance
 from ..robot import Robot, make_rng
-from ..scene import Scene
+from ..scene import Scene, check_scene
 
 CHUNK = 1024  # query rows per kernel block
 FIT_MAX = 3000  # labelled configurations in the fitted surrogate
@@ -222,6 +222,7 @@ class DiffCo:
 
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
         """(B,) −s(q) (or the fitted surrogate); ``scene`` only checks q (obstacles unused)."""
+        check_scene(scene, "planar")
         q = scene.robot.check_q(q)
         feats = self.kernel.features(q)
         sf = self.kernel.features(self.centers)
@@ -239,6 +240,7 @@ class DiffCo:
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)) the value and its exact gradient through the node Jacobians."""
+        check_scene(scene, "planar")
         q = scene.robot.check_q(q)
         n_nodes = self.kernel.robot.n_nodes
         feats = self.kernel.features(q)  # (B, 2N) = x / √N
