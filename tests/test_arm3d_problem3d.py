@@ -4,15 +4,17 @@ import math
 
 import numpy as np
 
-from gdnplan.arm3d import signed_distance3d
+from gdnplan.arm3d import checker3d, signed_distance3d
 from gdnplan.arm3d.problem3d import collision_fraction, reaching_problems, reaching_scene
 
 
 def test_reaching_problems_have_clear_ends_and_a_colliding_line():
     problems = reaching_problems("ur5e", 2, seed=5)
     for p in problems:
-        ends = signed_distance3d(p.scene, np.stack([p.start, p.goal]))
-        assert np.all(ends > p.margin)
+        ends = np.stack([p.start, p.goal])
+        clear = checker3d(p.scene).evaluate(ends, contact_offset=p.margin).distance
+        assert np.all(clear > p.margin)  # contact-only self pairs: d > 0 (offset = margin)
+        assert np.all(signed_distance3d(p.scene, ends) > 0)
         line = p.start + np.linspace(0, 1, 50)[:, None] * (p.goal - p.start)
         assert np.min(signed_distance3d(p.scene, line)) <= 0
         assert np.all(p.lower >= -math.pi) and np.all(p.upper <= math.pi)

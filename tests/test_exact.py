@@ -9,6 +9,7 @@ from gdnplan.arm3d import (
     Scene3D,
     box_obstacle,
     certify_path3d,
+    checker3d,
     load_robot3d,
     motion_bound3d,
     signed_distance3d,
@@ -31,10 +32,16 @@ def test_each_kind_answers_with_its_own_geometry():
     s2, s3 = planar_scene(), scene3d()
     q2, q3 = s2.robot.sample(6, seed=1), np.random.default_rng(0).uniform(-3, 3, (6, 6))
     np.testing.assert_array_equal(exact_distance(s2, q2), signed_distance(s2, q2))
-    np.testing.assert_array_equal(exact_distance(s3, q3), signed_distance3d(s3, q3))
+    # margin 0: true distances (contact-only self pairs included, gdnplan.arm3d.pairs)
+    np.testing.assert_array_equal(exact_distance(s3, q3, margin=0.0), signed_distance3d(s3, q3))
     np.testing.assert_array_equal(
-        exact_distance(s3, q3, per_link=True), signed_distance3d(s3, q3, per_link=True)
+        exact_distance(s3, q3, per_link=True, margin=0.0),
+        signed_distance3d(s3, q3, per_link=True),
     )
+    left_out = checker3d(s3).evaluate(q3).distance  # no margin: contact-only pairs left out
+    np.testing.assert_array_equal(exact_distance(s3, q3), left_out)
+    shifted = checker3d(s3).evaluate(q3, contact_offset=0.02).distance
+    np.testing.assert_array_equal(exact_distance(s3, q3, margin=0.02), shifted)
     np.testing.assert_array_equal(
         motion_bound_of(s2.robot, q2[:3], q2[3:]), motion_bound(s2.robot, q2[:3], q2[3:])
     )

@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..limits import check_int, check_number
 from ..trajopt.problem import Problem
 from .builtin import load_robot3d
-from .distance3d import signed_distance3d
+from .distance3d import checker3d, signed_distance3d
 from .robot3d import Robot3D
 from .scene3d import Scene3D, random_boxes
 
@@ -61,7 +61,7 @@ def _draw_pair(scene: Scene3D, rng: np.random.Generator, margin: float, box):
     s = np.linspace(0.0, 1.0, LINE_SAMPLES)[:, None]
     for _ in range(MAX_DRAWS):
         ends = rng.uniform(box[0], box[1], (2, len(box[0])))
-        d = signed_distance3d(scene, ends)
+        d = checker3d(scene).evaluate(ends, contact_offset=margin).distance  # contact-only: d ≥ 0
         if np.any(d <= margin) or np.any(proven_distance(d) <= margin):
             continue
         line = ends[0] + s * (ends[1] - ends[0])
