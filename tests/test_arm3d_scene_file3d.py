@@ -234,9 +234,11 @@ def test_a_user_urdf_with_its_srdf(tmp_path):
         "srdf": "arm.srdf",
         "joints": list(load_robot3d("ur5e").joint_names),
         "locked": {"left_finger_joint": 0.02, "right_finger_joint": 0.02},
+        "contact_only": [["forearm_link", "wrist_2_link"], ["forearm_link", "wrist_3_link"]],
     }
     problem = Problem.from_config(cfg, tmp_path)
     builtin = load_robot3d("ur5e")
+    assert problem.scene.robot.contact_only == builtin.contact_only
     assert problem.scene.robot.dof == 6
     assert len(problem.scene.robot.self_pairs) == len(builtin.self_pairs)
     q = np.array(cfg["start"]["q"])

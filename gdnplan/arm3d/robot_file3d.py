@@ -2,7 +2,8 @@
 it holds.
 
 ``name`` (ur5e, panda, ur5; ``finger``: each gripper finger's opening in m) or ``urdf`` (+
-``srdf``, ``package_dirs``, ``joints``, ``locked``), and an optional ``[robot.held]`` table: a
+``srdf``, ``package_dirs``, ``joints``, ``locked``, ``contact_only``: [link, link] pairs checked
+for contact only, :mod:`gdnplan.arm3d.pairs`), and an optional ``[robot.held]`` table: a
 shape (the keys of an obstacle, :mod:`gdnplan.arm3d.shape_file3d`) whose ``position`` and
 rotation are its pose ᶠM_obj in the tool frame f (``frame``, default the robot's tool frame),
 attached by :func:`gdnplan.arm3d.held.hold`. ``docs/problem_file_3d.md`` is the schema; every
@@ -25,7 +26,7 @@ from .robot3d import Robot3D, robot3d_from_urdf
 from .shape_file3d import file_path, posed_shape
 
 ROBOT3D_KEYS = frozenset(
-    {"name", "finger", "urdf", "srdf", "package_dirs", "joints", "locked", "held"}
+    {"name", "finger", "urdf", "srdf", "package_dirs", "joints", "locked", "held", "contact_only"}
 )
 FINGERS = {"ur5e": (ur5e3d, MAX_OPENING / 2), "panda": (panda3d, 0.04)}  # name -> (make, max m)
 HELD_FRAME_KEY = "frame"  # [robot.held]'s own key besides a posed shape's (POSE_KEYS, sizes)
@@ -87,6 +88,7 @@ def _urdf(table: dict, base_dir: Path) -> Robot3D:
         joints=joints,
         locked={k: float(v) for k, v in locked.items()},
         srdf=paths.get("srdf"),
+        contact_only=table.get("contact_only", ()),
     )
 
 
