@@ -180,9 +180,14 @@ class _Linear:
             return self.q[[0] * len(t)], z, z
         k = _segment_of(self.times, t)
         tau = self.tau[k][:, None]
-        rate = np.divide(1.0, tau, out=np.zeros_like(tau), where=tau > 0)
-        frac = np.clip((t - self.times[k])[:, None] * rate, 0.0, 1.0)
-        qd = self.step[k] * rate * (t < self.times[-1])[:, None]
+        # divided, not multiplied by 1/τ: a denormal τ (a step of ~1e-300 rad) has no finite
+        # reciprocal, while Δq/τ stays within the velocity limit
+        elapsed = (t - self.times[k])[:, None]
+        with np.errstate(over="ignore"):
+            frac = np.divide(elapsed, tau, out=np.zeros_like(elapsed), where=tau > 0)
+        frac = np.clip(frac, 0.0, 1.0)
+        moving = (tau > 0) & (t < self.times[-1])[:, None]
+        qd = np.divide(self.step[k], tau, out=np.zeros_like(self.step[k]), where=moving)
         return self.q[k] + frac * self.step[k], qd, np.zeros_like(qd)
 
 
