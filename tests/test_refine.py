@@ -173,9 +173,9 @@ def _trace_exact_rows(monkeypatch) -> list[tuple[str, np.ndarray | None]]:
     events: list[tuple[str, np.ndarray | None]] = []
     rows, draw, again = ipopt_module.with_exact_rows, ipopt_module.draw_seed, polish_module._again
 
-    def on_rows(model, splits, exact):
+    def on_rows(model, splits, exact, offset=0.0):
         events.append(("rows", exact.copy()))
-        return rows(model, splits, exact)
+        return rows(model, splits, exact, offset)
 
     def on_seed(*args, **kwargs):
         events.append(("seed", None))
@@ -219,3 +219,24 @@ def test_a_polish_starts_with_the_coal_rows_of_the_solve_that_made_its_path(squa
     ]
     polish_first = next(i for i in starts if kinds[i] == "again")
     assert any(np.array_equal(events[polish_first][1], m) for m in finals)
+
+
+def test_3d_coal_rows_hold_contact_only_pairs_to_contact_not_the_margin():
+    """The UR5e's forearm–wrist pairs never leave a 2 cm margin (contact-only,
+    gdnplan.arm3d.pairs): coal rows of a learned 3-D plan count them as d + margin, as the
+    planner's coal model and the certificate do, so a row ≥ margin asks them for d ≥ 0 only,
+    not for a clearance they can never have (every row would be violated)."""
+    from gdnplan.arm3d import Scene3D, load_robot3d, signed_distance3d
+    from gdnplan.arm3d.distance3d import Coal3DModel
+    from gdnplan.trajopt.refine import ExactRows
+
+    robot = load_robot3d("ur5e")
+    scene = Scene3D(robot, [])
+    q = robot.random_configurations(40, np.random.default_rng(0))
+    rows = ExactRows(Coal3DModel(), np.ones(len(q), bool), offset=0.02)
+    d, g = rows.distance_and_grad(scene, q)
+    want, want_g = Coal3DModel(contact_offset=0.02).distance_and_grad(scene, q)
+    np.testing.assert_allclose(d, want)
+    np.testing.assert_allclose(g, want_g)
+    true = signed_distance3d(scene, q)
+    assert true.max() < 0.02 < d.max()  # without the offset no row could reach the margin

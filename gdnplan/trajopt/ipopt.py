@@ -184,7 +184,7 @@ def _solve_refined(
     exact = np.zeros(len(splits), bool)  # segments whose check points have coal rows
     if exact_rows:  # coal rows where the model alone violates the bound (refine.py), and
         exact = underestimated_segments(  # where the solve that made guess had them
-            problem.scene, model, guess, splits, margin, refine.raise_window
+            problem.scene, model, guess, splits, margin, refine.raise_window, problem.margin
         )
         if run.exact is not None and len(run.exact) == len(exact):
             exact |= run.exact
@@ -197,7 +197,7 @@ def _solve_refined(
             left = min(max(deadline - t0, 1e-3), ipopt.options.get("max_wall_time", math.inf))
             ipopt = replace(ipopt, options={**ipopt.options, "max_wall_time": left})
         nlp = _Transcription(
-            problem, with_exact_rows(model, splits, exact), goal, ipopt, splits,
+            problem, with_exact_rows(model, splits, exact, problem.margin), goal, ipopt, splits,
             margin + _check_point_raise(splits, raised), duals is not None,
         )  # fmt: skip
         q, stats = nlp.solve(q, duals)

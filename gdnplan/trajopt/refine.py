@@ -28,7 +28,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..arm3d.distance3d import signed_distance3d, signed_distance3d_and_grad
+from ..arm3d.distance3d import Coal3DModel
 from ..arm3d.scene3d import Scene3D
 from ..distance import signed_distance, signed_distance_and_grad
 from ..models import DistanceModel
@@ -41,15 +41,22 @@ from .check_points import (
 )
 
 
-def _exact(scene: Scene | Scene3D, q: np.ndarray) -> np.ndarray:
-    """Coal's signed distance of the scene's kind (planar or 3-D)."""
-    return signed_distance3d(scene, q) if isinstance(scene, Scene3D) else signed_distance(scene, q)
-
-
-def _exact_and_grad(scene: Scene | Scene3D, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Coal's signed distance and witness gradient of the scene's kind."""
+def _exact(scene: Scene | Scene3D, q: np.ndarray, offset: float) -> np.ndarray:
+    """Coal's signed distance of the scene's kind (planar or 3-D); 3-D contact-only self pairs
+    count as d + ``offset`` (m, the problem's margin: they are held to d ≥ 0,
+    :mod:`gdnplan.arm3d.pairs`)."""
     if isinstance(scene, Scene3D):
-        return signed_distance3d_and_grad(scene, q)
+        return Coal3DModel(contact_offset=offset).distance(scene, q)
+    return signed_distance(scene, q)
+
+
+def _exact_and_grad(
+    scene: Scene | Scene3D, q: np.ndarray, offset: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Coal's signed distance and witness gradient of the scene's kind (``offset`` as in
+    :func:`_exact`)."""
+    if isinstance(scene, Scene3D):
+        return Coal3DModel(contact_offset=offset).distance_and_grad(scene, q)
     return signed_distance_and_grad(scene, q)
 
 
@@ -69,8 +76,9 @@ class ExactRows:
     (``distance_deferred_grad``) when it has one.
     """
 
-    def __init__(self, model: DistanceModel, exact: np.ndarray) -> None:
+    def __init__(self, model: DistanceModel, exact: np.ndarray, offset: float = 0.0) -> None:
         self.model, self.exact = model, np.asarray(exact, bool)
+        self.offset = offset  # 3-D contact-only pairs: d + offset (the problem's margin)
         self.name = f"{model.name} + coal rows"
         if hasattr(model, "distance_deferred_grad"):
             self.distance_deferred_grad = self._deferred
@@ -85,7 +93,7 @@ class ExactRows:
         if (~m).any():
             d[~m] = self.model.distance(scene, q[~m])
         if m.any():
-            d[m] = _exact(scene, q[m])
+            d[m] = _exact(scene, q[m], self.offset)
         return d
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -95,7 +103,7 @@ class ExactRows:
         if (~m).any():
             d[~m], g[~m] = self.model.distance_and_grad(scene, q[~m])
         if m.any():
-            d[m], g[m] = _exact_and_grad(scene, q[m])
+            d[m], g[m] = _exact_and_grad(scene, q[m], self.offset)
         return d, g
 
     def _deferred(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
@@ -106,7 +114,7 @@ class ExactRows:
         if (~m).any():
             d[~m], learned = self.model.distance_deferred_grad(scene, q[~m])
         if m.any():
-            d[m], g_exact = _exact_and_grad(scene, q[m])
+            d[m], g_exact = _exact_and_grad(scene, q[m], self.offset)
 
         def grad() -> np.ndarray:
             g = np.empty(q.shape)
@@ -126,16 +134,18 @@ def underestimated_segments(
     splits: np.ndarray,
     bound: np.ndarray | float,
     window: int | None,
+    offset: float = 0.0,
 ) -> np.ndarray:
     """(T − 1,) bool: the segments of the path q (T, dof) holding an inner check point of
     ``splits`` with d̂(p_k) < b_k ≤ d_coal(p_k) (the model alone violates the bound ``bound``
     (K,) or scalar, m), and ``window`` segments either side of each (all when None); a waypoint
-    check point marks both its segments. Costs one model and one coal call on the K points."""
+    check point marks both its segments. Costs one model and one coal call on the K points;
+    ``offset``: the problem's margin, added to 3-D contact-only pairs (:func:`_exact`)."""
     points = _interpolation_matrix(splits)[1:-1] @ q
     bound = np.broadcast_to(np.asarray(bound, float), (len(points),))
     low = model.distance(scene, points) < bound
     if low.any():
-        low[low] = _exact(scene, points[low]) >= bound[low]
+        low[low] = _exact(scene, points[low], offset) >= bound[low]
     if not low.any():
         return np.zeros(len(splits), bool)
     s = _path_parameters(splits)[1:-1][low]
@@ -144,12 +154,15 @@ def underestimated_segments(
     return _near_segments(hits.astype(int).tolist(), len(splits), window)
 
 
-def with_exact_rows(model: DistanceModel, splits: np.ndarray, exact: np.ndarray) -> DistanceModel:
+def with_exact_rows(
+    model: DistanceModel, splits: np.ndarray, exact: np.ndarray, offset: float = 0.0
+) -> DistanceModel:
     """``model`` with coal rows at the check points of the segments ``exact`` (T − 1,) bool
-    (:class:`ExactRows`); ``model`` itself when no segment is marked."""
+    (:class:`ExactRows`; ``offset`` as in :func:`_exact`); ``model`` itself when no segment is
+    marked."""
     if not exact.any():
         return model
-    return ExactRows(model, exact_check_points(splits, exact))
+    return ExactRows(model, exact_check_points(splits, exact), offset)
 
 
 __all__ = ["ExactRows", "exact_check_points", "underestimated_segments", "with_exact_rows"]
