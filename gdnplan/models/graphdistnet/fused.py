@@ -89,20 +89,6 @@ if AVAILABLE:
     _jit = numba.njit(cache=True, fastmath=True, nogil=True)
 
     @_jit
-    def _softmax_inplace(w):
-        """w (C,) ← softmax(w), the largest entry subtracted first."""
-        top = w[0]
-        for c in range(1, w.shape[0]):
-            top = max(top, w[c])
-        total = w[0] * 0
-        for c in range(w.shape[0]):
-            e = np.exp(w[c] - top)
-            w[c] = e
-            total += e
-        for c in range(w.shape[0]):
-            w[c] /= total
-
-    @_jit
     def _log_phi_backward(near, dlphi, dnear, real):
         """dnear (C,) += ∂/∂d² of Σ_c dlphi_c log φ_c, φ_c = d²_{real−1} − d²_c, over one
         node's first ``real`` candidates (φ floored at 1e-12 has no gradient)."""
