@@ -7,6 +7,7 @@ Booleans are never numbers, strings never numbers (``margin = true`` is no 1 m).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -117,12 +118,33 @@ def check_number(value, name: str, low: float = 0.0, strict: bool = False) -> fl
     return float(value)
 
 
-def check_int(value, name: str, low: int, high: int) -> int:
-    """An integer in [low, high], else InputError naming ``name`` and the limit."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InputError(f"{name}: expected an integer in [{low}, {high}], got {value!r}")
-    if not low <= value <= high:
-        raise InputError(f"{name}: {value} is outside [{low}, {high}] (the limit)")
+def shown(value: object, limit: int = 40) -> str:
+    """``repr(value)`` cut to ``limit`` characters (huge ints and strings stay one short line;
+    a numpy scalar shows as its Python value)."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    try:
+        text = repr(value)
+    except ValueError:  # an int beyond Python's digit limit for str()
+        return f"an integer of about {value.bit_length() * 0.30103:.0f} digits"
+    except RecursionError:  # lists nested deeper than repr follows
+        return f"a {type(value).__name__} nested too deeply to show"
+    return text if len(text) <= limit else f"{text[:limit]}…"
+
+
+def is_integer(value: object) -> bool:
+    """An int or numpy integer (any :class:`numbers.Integral`), not a bool."""
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
+
+
+def check_int(value: object, name: str, low: int, high: int | None = None, note: str = "") -> int:
+    """``value`` as an int when it is an integer (numpy integers too, bools never) in
+    [``low``, ``high``] (``high`` None: no upper bound), else InputError naming ``name`` and
+    the allowed range, followed by ``note`` (why the range) in brackets when given."""
+    if not is_integer(value) or value < low or (high is not None and value > high):
+        allowed = f"≥ {low}" if high is None else f"in [{low}, {high}]"
+        why = f" ({note})" if note else ""
+        raise InputError(f"{name}: expected an integer {allowed}{why}, got {shown(value)}")
     return int(value)
 
 
@@ -155,10 +177,6 @@ def check_ipopt_number(value, where: str, allowed: IpoptRange) -> None:
     """InputError naming ``where`` and the range unless ``value`` is a number (an integer for
     an integer option) in ``allowed``."""
     what = "an integer" if allowed.kind is int else "a number"
-    typed = (
-        isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-        if allowed.kind is int
-        else is_number(value)
-    )
+    typed = is_integer(value) if allowed.kind is int else is_number(value)
     if not typed or not math.isfinite(value) or not allowed.holds(value):
         raise InputError(f"{where}: expected {what} in {allowed.text()}, got {value!r}")

@@ -105,13 +105,13 @@ def test_clearancenet_runs_under_its_count(caller_threads):
 def test_load_model_takes_threads():
     assert gp.load_model(WEIGHTS / "a.safetensors", threads=2).threads == 2
     assert gp.load_model(WEIGHTS / "clearancenet_a.safetensors").threads is None
-    with pytest.raises(gp.InputError, match="threads: expected an integer ≥ 1"):
+    with pytest.raises(gp.InputError, match=r"threads: expected an integer in \[1, "):
         gp.load_model(WEIGHTS / "a.safetensors", threads=0)
 
 
 @pytest.mark.parametrize("bad", [0, -1, 1.5, True, "2"])
 def test_bad_thread_counts_are_input_errors(bad):
-    with pytest.raises(gp.InputError, match="threads: expected an integer ≥ 1"):
+    with pytest.raises(gp.InputError, match=r"threads: expected an integer in \[1, "):
         th.check_threads(bad)
     with pytest.raises(gp.InputError, match="threads"):
         th.set_inference_threads(bad)

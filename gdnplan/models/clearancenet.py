@@ -119,7 +119,7 @@ def _checked(c: ClearanceNetConfig) -> dict:
     vertices, ``dropout`` in [0, 0.99], ``scale`` in [1e-3, 1e3] m (float32-safe)."""
     if not isinstance(c.env, str) or not 0 < len(c.env) <= 64:
         raise InputError(f"env: expected an environment name, got {shown(c.env)}")
-    counts = {k: check_int(k, getattr(c, k), 1, high) for k, high in LIMITS.items()}
+    counts = {k: check_int(getattr(c, k), k, 1, high) for k, high in LIMITS.items()}
     return counts | {
         "encoding": check_choice("encoding", c.encoding, ("pose", "vertices")),
         "hidden": check_widths("hidden", c.hidden),

@@ -6,7 +6,8 @@ buffers of every inference call. So every field is checked for its type and rang
 network is built (InputError naming the field; :func:`gdnplan.models.checks.card_config` adds
 the card's file name):
 
-* integers are ints (not floats, not bools) within their bounds;
+* integers are ints (not floats, not bools) within their bounds
+  (:func:`gdnplan.limits.check_int`, imported here with :func:`~gdnplan.limits.shown`);
 * flags are ``true`` / ``false`` only (not ``"false"``, not 0 / 1);
 * choices are strings from their set;
 * layer widths are lists of positive ints, at most :data:`MAX_DEPTH` of them;
@@ -28,6 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import InputError
+from ..limits import check_int, shown
 
 MIN_LENGTH, MAX_LENGTH = 1e-3, 1e3  # m: scale, length, |origin| (and correction bands below)
 MAX_LAYERS = 64  # message-passing layers
@@ -38,30 +40,8 @@ MAX_PROBE_SPLIT = 32  # pieces per ring edge: (batch × edges × pieces) probe p
 MIN_TEMPERATURE, MAX_TEMPERATURE = 1e-12, 1e6  # τ, τ_m (normalised units; stored as a log)
 
 
-def shown(value: object, limit: int = 40) -> str:
-    """``repr(value)`` cut to ``limit`` characters (huge ints and strings stay one short line)."""
-    try:
-        text = repr(value)
-    except ValueError:  # an int beyond Python's digit limit for str()
-        return f"an integer of about {value.bit_length() * 0.30103:.0f} digits"
-    except RecursionError:  # lists nested deeper than repr follows
-        return f"a {type(value).__name__} nested too deeply to show"
-    return text if len(text) <= limit else f"{text[:limit]}…"
-
-
-def _is_int(value: object) -> bool:
-    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
-
-
 def _is_real(value: object) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def check_int(name: str, value: object, low: int, high: int) -> int:
-    """``value`` as an int when it is an integer (not a bool) in ``low`` … ``high``."""
-    if not _is_int(value) or not low <= value <= high:
-        raise InputError(f"{name}: expected an integer in {low} … {high}, got {shown(value)}")
-    return int(value)
 
 
 def check_real(name: str, value: object, low: float, high: float, unit: str = "") -> float:
@@ -93,7 +73,7 @@ def check_widths(name: str, value: object, depth: int = MAX_DEPTH) -> tuple[int,
         raise InputError(
             f"{name}: expected a list of at most {depth} layer widths, got {shown(value)}"
         )
-    return tuple(check_int(f"{name}[{i}]", v, 1, MAX_WIDTH) for i, v in enumerate(value))
+    return tuple(check_int(v, f"{name}[{i}]", 1, MAX_WIDTH) for i, v in enumerate(value))
 
 
 def check_point(name: str, value: object, dim: int, bound: float = MAX_LENGTH) -> tuple:

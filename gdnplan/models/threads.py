@@ -31,11 +31,11 @@ import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from ..errors import InputError
-from .fields import shown
+from ..limits import check_int
 
 DEFAULT_THREADS = 1
 MAX_THREADS = max(256, 4 * (os.cpu_count() or 1))  # the largest count accepted (docstring)
+THREADS_LIMIT = "the limit: 4 per core, at least 256"  # why MAX_THREADS, in messages
 _DEFAULT = {"threads": DEFAULT_THREADS}
 
 
@@ -44,13 +44,8 @@ def check_threads(threads: object, name: str = "threads", default: bool = True) 
     :data:`MAX_THREADS` (bools refused), else InputError naming ``name``."""
     if threads is None and default:
         return None
-    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= MAX_THREADS:
-        none = " (or None: the default)" if default else ""
-        raise InputError(
-            f"{name}: expected an integer ≥ 1 and ≤ {MAX_THREADS} (the limit: 4 per core, at "
-            f"least 256){none}, got {shown(threads)}"
-        )
-    return threads
+    note = THREADS_LIMIT + ("; or None: the default" if default else "")
+    return check_int(threads, name, 1, MAX_THREADS, note)
 
 
 def inference_threads() -> int:
@@ -70,7 +65,8 @@ def torch_threads(threads: int | None) -> Iterator[int]:
     then restore the count the caller had; yields the count used."""
     import torch
 
-    n = inference_threads() if check_threads(threads) is None else threads
+    checked = check_threads(threads)
+    n = inference_threads() if checked is None else checked
     before = torch.get_num_threads()
     if n == before:
         yield n

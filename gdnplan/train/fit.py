@@ -32,10 +32,12 @@ import torch
 from tqdm import tqdm
 
 from ..errors import InputError
+from ..limits import check_int
 from .checkpoint import load_checkpoint, save_checkpoint
 
 CLOCKS = {"wall": time.perf_counter, "cpu": time.process_time}  # FitConfig.budget_clock
 PLATEAU = 3  # epochs without improvement before the learning rate is halved
+COUNTS = {"batch": 1, "epochs": 1, "patience": 1, "seed": 0}  # integer fields: least value
 
 
 @dataclass(frozen=True)
@@ -66,17 +68,14 @@ class FitConfig:
 
     def __post_init__(self) -> None:
         check_schedule(self)
-
-
-def _positive_int(name: str, value: object, least: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < least:
-        raise InputError(f"{name}: expected an integer ≥ {least}, got {value!r}")
+        for name in COUNTS:  # numpy integers kept as ints (cards store them as JSON)
+            object.__setattr__(self, name, int(getattr(self, name)))
 
 
 def check_schedule(c: FitConfig) -> None:
     """InputError naming the first field of ``c`` that is not usable."""
-    for name, least in (("batch", 1), ("epochs", 1), ("patience", 1), ("seed", 0)):
-        _positive_int(name, getattr(c, name), least)
+    for name, least in COUNTS.items():
+        check_int(getattr(c, name), name, least)
     if not (isinstance(c.lr, (int, float)) and math.isfinite(c.lr) and c.lr >= 0):
         raise InputError(f"lr: expected a finite learning rate ≥ 0, got {c.lr!r}")
     budget = c.time_budget

@@ -160,18 +160,18 @@ def _checked(c: GraphDistNetConfig) -> dict:
     """The fields of ``c`` checked (bounds: :mod:`gdnplan.models.fields`)."""
     band = c.correction_band
     return {
-        "layers": check_int("layers", c.layers, 1, MAX_LAYERS),
-        "hidden": check_int("hidden", c.hidden, 1, MAX_WIDTH),
+        "layers": check_int(c.layers, "layers", 1, MAX_LAYERS),
+        "hidden": check_int(c.hidden, "hidden", 1, MAX_WIDTH),
         "mlp": check_widths("mlp", c.mlp),
         "readout": check_widths("readout", c.readout),
         "cross": check_choice("cross", c.cross, ("argmax", "soft_knn")),
-        "cross_k": check_int("cross_k", c.cross_k, 1, MAX_CROSS_K),
+        "cross_k": check_int(c.cross_k, "cross_k", 1, MAX_CROSS_K),
         "two_way": check_flag("two_way", c.two_way),
         "tau": check_real("tau", c.tau, MIN_TEMPERATURE, MAX_TEMPERATURE),
         "node_distance": check_flag("node_distance", c.node_distance),
         "min_readout": check_flag("min_readout", c.min_readout),
         "tau_min": check_real("tau_min", c.tau_min, MIN_TEMPERATURE, MAX_TEMPERATURE),
-        "probe_split": check_int("probe_split", c.probe_split, 1, MAX_PROBE_SPLIT),
+        "probe_split": check_int(c.probe_split, "probe_split", 1, MAX_PROBE_SPLIT),
         "correction_band": None
         if band is None
         else check_real("correction_band", band, MIN_LENGTH, MAX_LENGTH, " m"),

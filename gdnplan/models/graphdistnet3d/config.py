@@ -91,16 +91,16 @@ class GraphDistNet3DConfig:
 def _checked(c: GraphDistNet3DConfig) -> dict:
     """The fields of ``c`` checked (bounds: :mod:`gdnplan.models.fields`)."""
     return {
-        "layers": check_int("layers", c.layers, 1, MAX_LAYERS),
-        "hidden": check_int("hidden", c.hidden, 1, MAX_WIDTH),
+        "layers": check_int(c.layers, "layers", 1, MAX_LAYERS),
+        "hidden": check_int(c.hidden, "hidden", 1, MAX_WIDTH),
         "mlp": check_widths("mlp", c.mlp),
         "readout": check_widths("readout", c.readout),
-        "cross_k": check_int("cross_k", c.cross_k, 1, MAX_CROSS_K),
+        "cross_k": check_int(c.cross_k, "cross_k", 1, MAX_CROSS_K),
         "tau": check_real("tau", c.tau, MIN_TEMPERATURE, MAX_TEMPERATURE),
         "length": check_real("length", c.length, MIN_LENGTH, MAX_LENGTH, " m"),
         "scale": check_real("scale", c.scale, MIN_LENGTH, MAX_LENGTH, " m"),
         "origin": check_point("origin", c.origin, 3),
-        "rim": check_int("rim", c.rim, 3, MAX_RIM),
+        "rim": check_int(c.rim, "rim", 3, MAX_RIM),
         "min_readout": check_flag("min_readout", c.min_readout),
         "tau_min": check_real("tau_min", c.tau_min, MIN_TEMPERATURE, MAX_TEMPERATURE),
     }
