@@ -233,6 +233,10 @@ class Coal3DModel:
     def __init__(self, contact_offset: float = 0.0):
         self.contact_offset = check_offset(contact_offset)
 
+    def with_contact_offset(self, contact_offset: float) -> Coal3DModel:
+        """The model with contact-only pairs offset by ``contact_offset`` (m)."""
+        return Coal3DModel(contact_offset)
+
     def distance(self, scene: Scene3D, q: np.ndarray) -> np.ndarray:
         check_scene(scene, "3d", "gdnplan.signed_distance")
         return checker3d(scene).evaluate(q, contact_offset=self.contact_offset).distance

@@ -127,8 +127,8 @@ def plan(
     if max_acceleration is not None:
         max_acceleration = limit_vector(max_acceleration, dof, "max_acceleration", "rad/s²")
     model = resolve_model(collision, problem.scene, weights)
-    if isinstance(model, Coal3DModel):  # contact-only pairs: rows d + margin ≥ bound ≥ margin
-        model = Coal3DModel(contact_offset=problem.margin)
+    if hasattr(model, "with_contact_offset"):  # contact-only pairs: rows d + margin ≥ margin
+        model = model.with_contact_offset(problem.margin)
     goal = problem.goal
     if goal is None:  # the joint goal of goal_position: the step bound must still reach it
         goal = numeric_ik(problem, seed)

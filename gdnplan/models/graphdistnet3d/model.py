@@ -11,10 +11,15 @@ pass — d̂ and ∂d̂/∂p in one call per batch, no chunks — as the compile
 Self-collision stays exact (``self_collision=True``): the reported distance is min(d̂, d_self)
 with d_self coal's signed distance over the robot's enabled self pairs
 (:class:`~gdnplan.arm3d.Checker3D` of the robot alone), and the gradient is the minimiser's.
+Contact-only self pairs (:mod:`gdnplan.arm3d.pairs`) enter d_self as d_k + o with o =
+``contact_offset`` (m), as in :class:`~gdnplan.arm3d.Coal3DModel`: 0 (default) gives true signed
+distances; the planner passes its margin M (:meth:`GraphDistNet3DModel.with_contact_offset`), so
+that its rows d ≥ M also hold those pairs at d ≥ 0.
 """
 
 from __future__ import annotations
 
+import copy
 import weakref
 from dataclasses import dataclass
 
@@ -22,6 +27,7 @@ import numpy as np
 import torch
 
 from ...arm3d import Checker3D, Scene3D
+from ...arm3d.narrow3d import check_offset
 from ...errors import InputError
 from ...graph3d import (
     ObstacleGraph3D,
@@ -126,8 +132,10 @@ class GraphDistNet3DModel:
         dtype: torch.dtype = torch.float32,
         threads: int | None = None,
         fused: bool | None = None,
+        contact_offset: float = 0.0,
     ):
         self.net = net.to(dtype=dtype).eval()
+        self.contact_offset = check_offset(contact_offset)
         self.config = net.config
         self.card = card or {}
         self.self_collision = self_collision
@@ -136,6 +144,13 @@ class GraphDistNet3DModel:
         self.threads = check_threads(threads)
         self.fused = self._check_fused(fused)
         self._scenes: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    def with_contact_offset(self, contact_offset: float) -> GraphDistNet3DModel:
+        """This model with contact-only pairs offset by ``contact_offset`` (m); the copy shares
+        the network and the per-scene caches (they do not depend on the offset)."""
+        twin = copy.copy(self)
+        twin.contact_offset = check_offset(contact_offset)
+        return twin
 
     def _check_fused(self, fused: bool | None) -> bool:
         """The ``fused`` setting resolved (module docstring); InputError when True cannot be."""
@@ -220,7 +235,8 @@ class GraphDistNet3DModel:
         checker = self._cache(scene).self_checker
         if checker is None:
             return d
-        return np.minimum(d, checker.evaluate(q).distance)
+        own = checker.evaluate(q, contact_offset=self.contact_offset).distance
+        return np.minimum(d, own)
 
     def distance_and_grad(self, scene: Scene3D, q) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)): the distance of :meth:`distance` and its gradient (m/rad)."""
@@ -228,6 +244,6 @@ class GraphDistNet3DModel:
         checker = self._cache(scene).self_checker
         if checker is None:
             return d, g
-        res = checker.evaluate(q, gradient=True)
+        res = checker.evaluate(q, gradient=True, contact_offset=self.contact_offset)
         own = res.distance < d
         return np.where(own, res.distance, d), np.where(own[:, None], res.gradient, g)
