@@ -1,18 +1,10 @@
 """Robots: a Pinocchio model reduced to its planning plane, one convex 2-D polygon per link part.
 
 Every robot gdnplan plans for moves in a plane: all planning joints are revolute with axes along
-the plane normal ``n``. A point ``p`` rigidly attached to body ``b`` (the body after the first
-``b`` planning joints) therefore moves as the composition of plane rotations
-
-    p(q) = T_1(q_1) ∘ T_2(q_2) ∘ … ∘ T_b(q_b) (p⁰),    T_j(θ) = rotation by s_j θ about o_j⁰,
-
-where ``p⁰`` and ``o_j⁰`` are the point and joint ``j`` at ``q = 0`` (2-D plane coordinates) and
-``s_j = ±1`` is the sign of the joint axis along ``n``. Its Jacobian column is
-
-    ∂p/∂q_j = s_j ẑ × (p − o_j(q))   for j ≤ b,   0 otherwise.
-
-:class:`PlanarChain` evaluates both for a batch with a handful of numpy operations; Pinocchio
-stays the reference (``Robot.node_positions_pinocchio``) and a test proves the two equal.
+the plane normal ``n``, so its points move by plane rotations (:class:`PlanarChain`,
+:mod:`gdnplan.planar_chain`: batched positions and Jacobians in numpy); Pinocchio stays the
+reference (``Robot.node_positions_pinocchio``) and a test proves the two equal. Joint angles
+and seeds are checked by :mod:`gdnplan.robot_checks` (re-exported here).
 Robots are built from URDF files by :mod:`gdnplan.urdf_robot` (which checks that every
 planning joint turns about ``n``); this module looks robots up by name in the registry
 (:mod:`gdnplan.registry`), where :mod:`gdnplan.planar` and :mod:`gdnplan.ur5e` register the
@@ -31,79 +23,11 @@ import pinocchio as pin
 
 from .errors import InputError
 from .limits import check_int
+from .planar_chain import PlanarChain, cross_z, rot2
 from .registry import ROBOTS
+from .robot_checks import as_batch, check_seed, first_outside, make_rng
 
 MAX_SAMPLES = 10**8  # configurations of one Robot.sample call
-
-
-def rot2(theta: np.ndarray) -> np.ndarray:
-    """Rotation matrices of angles ``theta`` (...,) -> (..., 2, 2)."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
-
-
-def cross_z(v: np.ndarray) -> np.ndarray:
-    """ẑ × v for planar vectors v (..., 2)."""
-    return np.stack([-v[..., 1], v[..., 0]], -1)
-
-
-@dataclass(frozen=True)
-class PlanarChain:
-    """Serial chain of revolute joints that all rotate about the plane normal.
-
-    Attributes:
-        joint_origins: (dof, 2) joint positions at q = 0, plane coordinates (m).
-        joint_signs: (dof,) +1 when the joint axis is along the plane normal, -1 when opposite.
-    """
-
-    joint_origins: np.ndarray
-    joint_signs: np.ndarray
-
-    @property
-    def dof(self) -> int:
-        return len(self.joint_signs)
-
-    def transform(self, points0: np.ndarray, body: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """World positions at q of points attached to bodies.
-
-        Args:
-            points0: (N, 2) positions at q = 0.
-            body: (N,) number of planning joints upstream of each point (0 = fixed base).
-            q: (B, dof) joint angles (rad).
-
-        Returns:
-            (B, N, 2) positions (m).
-        """
-        p = np.broadcast_to(points0, (q.shape[0], *points0.shape)).copy()
-        for j in range(self.dof - 1, -1, -1):  # tip joint first: p = T_1 ∘ … ∘ T_b (p⁰)
-            moved = body > j
-            if not moved.any():
-                continue
-            o = self.joint_origins[j]
-            r = rot2(self.joint_signs[j] * q[:, j])  # (B, 2, 2)
-            p[:, moved] = o + np.einsum("bij,bnj->bni", r, p[:, moved] - o)
-        return p
-
-    def joint_positions(self, q: np.ndarray) -> np.ndarray:
-        """(B, dof, 2) positions of the joints at q (joint j sits on body j)."""
-        return self.transform(self.joint_origins, np.arange(self.dof), q)
-
-    def jacobian(self, points: np.ndarray, body: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """Jacobians ∂p/∂q of attached points already placed at q.
-
-        Args:
-            points: (B, N, 2) positions at q (from :meth:`transform`).
-            body: (N,) body index of each point.
-            q: (B, dof) joint angles.
-
-        Returns:
-            (B, N, 2, dof), column j = s_j ẑ × (p − o_j(q)) where joint j is upstream.
-        """
-        joints = self.joint_positions(q)  # (B, dof, 2)
-        lever = points[:, :, None, :] - joints[:, None, :, :]  # (B, N, dof, 2)
-        jac = cross_z(lever) * self.joint_signs[:, None]
-        jac = jac * (body[:, None] > np.arange(self.dof))[None, :, :, None]
-        return np.moveaxis(jac, 2, 3)
 
 
 @dataclass(frozen=True)
@@ -342,69 +266,6 @@ def _joint_axis(model: pin.Model, j: int) -> np.ndarray:
     raise InputError(f"joint {model.names[j]!r}: only revolute joints can be planning joints")
 
 
-def first_outside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, tol: float = 1e-9):
-    """Index of the first joint of q (dof,) outside [lower − tol, upper + tol], or None."""
-    out = np.flatnonzero((q < lower - tol) | (q > upper + tol))
-    return int(out[0]) if out.size else None
-
-
-_KINDS = {"b": "booleans", "U": "strings", "S": "bytes", "c": "complex numbers", "O": "objects"}
-
-
-def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
-    """Return q as a float64 (B, dof) array; a single (dof,) configuration becomes (1, dof).
-
-    InputError naming ``name`` unless q holds real numbers (numpy kinds integer, unsigned or
-    float): booleans, strings, complex numbers and other objects are refused, not coerced
-    (``"0.1"`` is no angle, ``True`` no 1 rad, 1 + 2j loses its imaginary part).
-    """
-    try:
-        arr = np.asarray(q)
-    except (TypeError, ValueError) as e:
-        raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from e
-    if arr.dtype.kind not in "iuf" or _holds_bool(q):
-        kind = "b" if arr.dtype.kind in "iuf" else arr.dtype.kind
-        what = _KINDS.get(kind, f"an array of {arr.dtype}")
-        raise InputError(f"{name}: expected real numbers (rad), got {what}")
-    if arr.ndim not in (1, 2) or arr.shape[-1] != dof:
-        raise InputError(f"{name}: expected shape (B, {dof}) or ({dof},), got {arr.shape}")
-    q = arr.astype(float, copy=False).reshape(-1, dof)
-    if not np.all(np.isfinite(q)):
-        raise InputError(f"{name}: contains NaN or infinite values")
-    return q
-
-
-def _holds_bool(q) -> bool:
-    """True when a (nested) list or tuple holds a boolean: numpy reads [True, 0.5] as float64
-    and the boolean vanishes, so the elements themselves are looked at."""
-    if not isinstance(q, (list, tuple)):
-        return False
-    return any(isinstance(x, (bool, np.bool_)) for x in np.asarray(q, dtype=object).ravel())
-
-
-def check_seed(seed, name: str = "seed"):
-    """A seed numpy's ``default_rng`` takes, else InputError: None (fresh entropy), an integer
-    ≥ 0 or a non-empty sequence of them; booleans are refused (``True`` is no seed)."""
-    if seed is None:
-        return None
-    items = seed if isinstance(seed, (list, tuple)) and seed else [seed]
-    for x in items:
-        if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)) or x < 0:
-            raise InputError(
-                f"{name}: expected None, an integer ≥ 0 or a list of them, got {seed!r}"
-            )
-    return seed
-
-
-def make_rng(seed, name: str = "seed") -> np.random.Generator:
-    """The generator of ``seed``: a ``numpy.random.Generator`` itself (drawn from directly, its
-    stream continues, as ``np.random.default_rng(generator)`` does), else
-    ``np.random.default_rng`` of a seed :func:`check_seed` allows (InputError otherwise)."""
-    if isinstance(seed, np.random.Generator):
-        return seed
-    return np.random.default_rng(check_seed(seed, name))
-
-
 # -------------------------------------------------------------------- registry
 def register_robot(name: str) -> Callable:
     """Decorator registering a robot factory under ``name`` for :func:`load_robot`."""
@@ -442,3 +303,24 @@ def load_robot(name: str, **options) -> Robot:
 
 
 _CACHE: dict[str, Robot] = {}
+
+
+__all__ = [  # re-exported too: planar_chain (PlanarChain, cross_z, rot2), robot_checks
+    "MAX_SAMPLES",
+    "LinkPolygon",
+    "PlanarChain",
+    "Plane",
+    "Robot",
+    "apply_se3",
+    "as_batch",
+    "check_seed",
+    "cross_z",
+    "factory_options",
+    "first_outside",
+    "load_robot",
+    "make_rng",
+    "register_robot",
+    "robot_names",
+    "robot_options",
+    "rot2",
+]

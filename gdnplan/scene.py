@@ -18,7 +18,7 @@ No obstacle comes within ``robot.base_radius`` of the first joint.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Set
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
@@ -26,30 +26,31 @@ from pathlib import Path
 import numpy as np
 from shapely.geometry import Point, Polygon
 
-from .errors import InputError, ProblemFileError, UnknownNameError
+from .errors import InputError, ProblemFileError
 from .geometry import (
     alpha_shape,
     as_polygon,
-    check_part,
     convex_decomposition,
     limit_vertices,
     square,
 )
 from .registry import SCENES
 from .robot import Robot, factory_options, load_robot, robot_names, robot_options
+from .scene_checks import (
+    MAX_OBSTACLES,
+    MAX_PARTS,
+    call_reporting,
+    check_obstacles,
+    check_robot,
+    coordinate_bound,
+    describe,
+    no_unknown_keys,
+)
 
-MAX_OBSTACLES = 1000  # obstacle polygons of one scene
-MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
 # problem-file keys (docs/problem_file.md documents each; tests/test_problem_file_docs.py checks)
 ROBOT_KEYS = frozenset({"name"})  # [robot]; plus the options of the named robot (robot_options)
 SCENE_KEYS = frozenset({"generator", "seed"})  # [scene]; plus the generator's (scene_options)
 OBSTACLE_KEYS = frozenset({"polygon"})  # each [[obstacles]] table
-
-
-def coordinate_bound(robot: Robot) -> float:
-    """Largest |x|, |y| offset (m) of an obstacle vertex from joint 1: max(100 m, 100 × reach).
-    Farther obstacles can never touch the arm, and huge coordinates (1e300) crashed coal."""
-    return max(100.0, 100.0 * robot.reach)
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,32 +75,8 @@ class Scene:
     info: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        _check_robot(self.robot)
-        if not isinstance(self.obstacles, (list, tuple, np.ndarray)):
-            got = _describe(self.obstacles)
-            raise InputError(f"obstacles: expected a list of (m, 2) polygons, got {got}")
-        if len(self.obstacles) > MAX_OBSTACLES:
-            raise InputError(
-                f"obstacles: {len(self.obstacles)} polygons, the limit is {MAX_OBSTACLES}"
-            )
-        checked = tuple(as_polygon(p, f"obstacles[{i}]") for i, p in enumerate(self.obstacles))
-        object.__setattr__(self, "obstacles", checked)
-        bound = coordinate_bound(self.robot)
-        base = self.robot.chain.joint_origins[0]
-        for i, poly in enumerate(checked):
-            far = float(np.max(np.abs(poly - base)))
-            if far > bound:
-                raise InputError(
-                    f"obstacles[{i}]: a vertex is {far:.3g} m from the robot's base, the limit "
-                    f"is {bound:.3g} m (max(100 m, 100 × reach)); remove or move the obstacle"
-                )
-            for part in convex_decomposition(poly):
-                check_part(part, f"obstacles[{i}]")
-        if len(self.obstacle_parts) > MAX_PARTS:
-            raise InputError(
-                f"obstacles: {len(self.obstacle_parts)} convex parts, the limit is {MAX_PARTS}; "
-                "use fewer or simpler (less non-convex) obstacles"
-            )
+        check_robot(self.robot)
+        object.__setattr__(self, "obstacles", check_obstacles(self.obstacles, self.robot))
 
     @cached_property
     def obstacle_parts(self) -> tuple[np.ndarray, ...]:
@@ -119,23 +96,6 @@ class Scene:
     def with_obstacles(self, obstacles) -> Scene:
         """The same robot with other obstacles."""
         return replace(self, obstacles=tuple(obstacles))
-
-
-def _describe(value) -> str:
-    """A value's type for messages, with the value itself when it is short (``str 'b'``)."""
-    text = repr(value)
-    return type(value).__name__ + (f" {text}" if len(text) <= 40 else "")
-
-
-def _check_robot(robot) -> None:
-    """InputError unless ``robot`` is a planar :class:`Robot` (a Robot3D belongs in a Scene3D)."""
-    if isinstance(robot, Robot):
-        return
-    from .arm3d.robot3d import Robot3D  # on demand: arm3d imports this module
-
-    if isinstance(robot, Robot3D):
-        raise InputError("robot: a 3-D robot (Robot3D): use gdnplan.arm3d.Scene3D")
-    raise InputError(f"robot: expected a Robot (gdnplan.load_robot), got {_describe(robot)}")
 
 
 KINDS = {"planar": "a planar Scene", "3d": "a Scene3D", "any": "a planar Scene or a Scene3D"}
@@ -158,7 +118,7 @@ def check_scene(scene, kind: str = "planar", use: str = "", name: str = "scene")
     hint = ""
     if isinstance(scene, str) and kind != "3d" and scene in SCENES:
         hint = f"; build it first: gdnplan.make_scene({scene!r})"
-    raise InputError(f"{name}: expected {KINDS[kind]}, got {_describe(scene)}{hint}")
+    raise InputError(f"{name}: expected {KINDS[kind]}, got {describe(scene)}{hint}")
 
 
 # -------------------------------------------------------------------- generators
@@ -299,7 +259,7 @@ def scene_from_config(cfg: dict, base_dir: str | Path | None = None) -> Scene:
             allowed = SCENE_KEYS | scene_options(generator)
             no_unknown_keys(scene_cfg, allowed, f"[scene] (generator {generator!r})")
         options = {k: v for k, v in scene_cfg.items() if k not in ("generator", "seed")}
-        base = _call("[scene]", make_scene, generator, seed=seed, **options)
+        base = call_reporting("[scene]", make_scene, generator, seed=seed, **options)
         obstacles += list(base.obstacles)
         name, info = base.name, dict(base.info)
     elif scene_cfg:
@@ -318,7 +278,7 @@ def scene_from_config(cfg: dict, base_dir: str | Path | None = None) -> Scene:
         if robot_cfg["name"] in robot_names():  # an unknown name is load_robot's error
             allowed = ROBOT_KEYS | robot_options(robot_cfg["name"])
             no_unknown_keys(robot_cfg, allowed, f"[robot] (name {robot_cfg['name']!r})")
-        robot = _call("[robot]", load_robot, robot_cfg["name"], **options)
+        robot = call_reporting("[robot]", load_robot, robot_cfg["name"], **options)
     elif base is not None and not robot_cfg:
         robot = base.robot
     else:
@@ -339,24 +299,34 @@ def scene_from_config(cfg: dict, base_dir: str | Path | None = None) -> Scene:
             obstacles.append(as_polygon(item["polygon"], f"obstacles[{i}].polygon"))
         except InputError as e:
             raise ProblemFileError(str(e)) from e
-    return _call("[[obstacles]]", Scene, robot, tuple(obstacles), name=name, seed=seed, info=info)
+    return call_reporting(
+        "[[obstacles]]", Scene, robot, tuple(obstacles), name=name, seed=seed, info=info
+    )
 
 
-def no_unknown_keys(table: dict, allowed: Set[str], where: str) -> None:
-    """ProblemFileError naming the keys of ``table`` not in ``allowed`` and listing these."""
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ProblemFileError(
-            f"{where}: unknown key(s) {unknown}; allowed: {sorted(allowed)}", schema=True
-        )
-
-
-def _call(where: str, factory: Callable, *args, **options):
-    """factory(*args, **options), with an unsupported option or a bad value (TypeError,
-    InputError) reported as a ProblemFileError naming the table."""
-    try:
-        return factory(*args, **options)
-    except UnknownNameError:
-        raise
-    except (TypeError, InputError) as e:
-        raise ProblemFileError(f"{where}: {e}") from e
+__all__ = [  # re-exported too: scene_checks (MAX_OBSTACLES, MAX_PARTS, coordinate_bound, …)
+    "C_LAYOUT_SEED",
+    "ENV_ROBOT",
+    "KINDS",
+    "MAX_OBSTACLES",
+    "MAX_PARTS",
+    "OBSTACLE_KEYS",
+    "ROBOT_KEYS",
+    "SCENE_KEYS",
+    "Scene",
+    "check_scene",
+    "clear_of_base",
+    "coordinate_bound",
+    "env_a",
+    "env_b",
+    "env_c",
+    "env_d",
+    "env_e",
+    "make_scene",
+    "no_unknown_keys",
+    "random_alpha_shape",
+    "register_scene",
+    "scene_from_config",
+    "scene_names",
+    "scene_options",
+]

@@ -29,11 +29,14 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "assets",
             "geometry",
             "registry",
+            "planar_chain",  # the plane rotations of a planar robot's chain
+            "robot_checks",  # joint-angle batches and seeds of robot calls
             "robot",
             "urdf_robot",
             "urdf_robot.*",
             "planar",
             "robot_file",
+            "scene_checks",  # a planar scene's robot, obstacles and problem-file tables
             "scene",
             "ur5e.kinematics",  # the UR5e/UR5 robot model: core robot modelling
             "ur5e.gripper",
@@ -67,6 +70,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.narrow3d",  # the pair table and coal's narrow phase of one pair
             "arm3d.gradient3d",  # the exact gradient of a pair's distance
             "arm3d.ccd3d",
+            "arm3d.ik3d_checks",  # the pose IK's settings and tool positions
             "arm3d.ik3d",
             "arm3d.held",
             "arm3d.fetch3d_scene",
@@ -82,7 +86,18 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("graphs", ("graph", "graph3d")),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
-    ("trajopt", ("trajopt", "trajopt.*", "timing", "arm3d.problem3d")),
+    (
+        "trajopt",
+        (
+            "trajopt",
+            "trajopt.*",
+            "timing",
+            "timing_checks",
+            "timing_profiles",
+            "timing_toppra",
+            "arm3d.problem3d",
+        ),
+    ),
     ("training", ("data", "data.*", "metrics", "train", "train.*", "train_clearancenet")),
     (
         "paper reproduction",

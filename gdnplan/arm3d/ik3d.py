@@ -32,8 +32,9 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from ..errors import InfeasibleProblemError, InputError
-from ..limits import check_int, check_number
+from ..limits import check_number
 from .distance3d import checker3d
+from .ik3d_checks import MAX_POINTS, MIN_TOL, check_ik_settings, check_positions
 from .robot3d import Robot3D
 from .scene3d import Scene3D
 from .shapes import as_rotation, as_vector
@@ -41,12 +42,10 @@ from .shapes import as_rotation, as_vector
 TOOL_FRAMES = {"ur5e": "gripper_tcp", "panda": "panda_hand_tcp", "ur5": "tool0"}
 DAMPING = 1e-3  # λ of the damped least squares (m or rad)
 MAX_STEP = 0.5  # rad: largest joint change of one step (|Δq|∞, scaled down)
-MIN_TOL = 1e-12  # m, rad: smallest position_tol / rotation_tol (the DLS reaches ~1e-14 at 1 m)
 NEAR = (
     1e-3,
     1e-2,
 )  # m, rad: a closest miss within these is "tolerance not met", not "out of reach"
-MAX_POINTS = 10_000  # cartesian_path: positions of one path
 
 
 @dataclass(frozen=True)
@@ -184,13 +183,7 @@ def solve_pose_ik(
     robot = scene.robot
     target = pose_target(position, rotation)
     fid = _frame_id(robot, frame)
-    check_number(margin, "margin", -np.inf)
-    check_int(restarts, "restarts", 1, 100_000)
-    check_int(solutions, "solutions", 1, 100_000)
-    check_int(iterations, "iterations", 1, 100_000)
-    for name, tol in (("position_tol", position_tol), ("rotation_tol", rotation_tol)):
-        if check_number(tol, name, 0.0, strict=True) < MIN_TOL:
-            raise InputError(f"{name}: {tol:g} is below {MIN_TOL:g}, what the IK solver reaches")
+    check_ik_settings(margin, restarts, solutions, iterations, position_tol, rotation_tol)
     mid = (robot.lower + robot.upper) / 2
     ref = mid if reference is None else robot.check_q(reference, "reference")[0]
     rng = np.random.default_rng(seed)
@@ -261,7 +254,7 @@ def cartesian_path(
     """
     scene = scene if isinstance(scene, Scene3D) else Scene3D(scene)
     q = [scene.robot.check_q(q0, "q0")[0]]
-    pts = _positions(positions)
+    pts = check_positions(positions)
     rotation = as_rotation(rotation, "rotation")
     check_number(margin, "margin", -np.inf)
     check_number(max_jump, "max_jump", 0.0, strict=True)
@@ -287,22 +280,9 @@ def cartesian_path(
     return np.array(q)
 
 
-def _positions(positions) -> np.ndarray:
-    """(K, 3) tool positions (m) from one point (3,) or K points, else InputError."""
-    try:
-        items = np.asarray(positions, dtype=object)
-    except ValueError:  # ragged nesting
-        items = np.asarray(None, dtype=object)
-    if items.shape == (3,):
-        items = items[None]
-    if items.ndim != 2 or items.shape[1] != 3 or not 1 <= len(items) <= MAX_POINTS:
-        raise InputError(
-            f"positions: expected (K, 3) points (m), 1 ≤ K ≤ {MAX_POINTS}, got {positions!r}"[:300]
-        )
-    return np.array([as_vector(list(p), 3, f"positions[{k}]") for k, p in enumerate(items)])
-
-
-__all__ = [
+__all__ = [  # MAX_POINTS, MIN_TOL: re-exported from ik3d_checks
+    "MAX_POINTS",
+    "MIN_TOL",
     "TOOL_FRAMES",
     "PoseIK",
     "cartesian_path",

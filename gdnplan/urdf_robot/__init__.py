@@ -8,7 +8,7 @@ n = u × v). Every other joint is locked, and at q = 0 each planning joint must 
 
     x ↦ (u · (x − o₁), v · (x − o₁)),     o₁ = planning joint 1's world position at q = 0,
 
-move by the plane rotations of :class:`~gdnplan.robot.PlanarChain`. A collision geometry
+move by the plane rotations of :class:`~gdnplan.planar_chain.PlanarChain`. A collision geometry
 becomes one link polygon that contains its projection: the convex hull of points whose hull
 contains the shape (box corners, polygons circumscribing the circles of cylinders, polyhedra
 circumscribing spheres, mesh vertices) in plane coordinates, simplified to at most

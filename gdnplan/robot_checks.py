@@ -1,0 +1,79 @@
+"""Input checks of robot calls: joint-angle batches, joint-limit lookups and random seeds.
+
+Joint angles are real numbers (numpy kinds integer, unsigned or float), never booleans,
+strings or complex numbers, and finite; a seed is what ``numpy.random.default_rng`` takes
+(None, an integer ≥ 0 or a non-empty list of them) or a ``numpy.random.Generator``. Anything
+else is an :class:`~gdnplan.errors.InputError` naming the argument.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import InputError
+
+
+def first_outside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, tol: float = 1e-9):
+    """Index of the first joint of q (dof,) outside [lower − tol, upper + tol], or None."""
+    out = np.flatnonzero((q < lower - tol) | (q > upper + tol))
+    return int(out[0]) if out.size else None
+
+
+_KINDS = {"b": "booleans", "U": "strings", "S": "bytes", "c": "complex numbers", "O": "objects"}
+
+
+def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
+    """Return q as a float64 (B, dof) array; a single (dof,) configuration becomes (1, dof).
+
+    InputError naming ``name`` unless q holds real numbers (numpy kinds integer, unsigned or
+    float): booleans, strings, complex numbers and other objects are refused, not coerced
+    (``"0.1"`` is no angle, ``True`` no 1 rad, 1 + 2j loses its imaginary part).
+    """
+    try:
+        arr = np.asarray(q)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from e
+    if arr.dtype.kind not in "iuf" or _holds_bool(q):
+        kind = "b" if arr.dtype.kind in "iuf" else arr.dtype.kind
+        what = _KINDS.get(kind, f"an array of {arr.dtype}")
+        raise InputError(f"{name}: expected real numbers (rad), got {what}")
+    if arr.ndim not in (1, 2) or arr.shape[-1] != dof:
+        raise InputError(f"{name}: expected shape (B, {dof}) or ({dof},), got {arr.shape}")
+    q = arr.astype(float, copy=False).reshape(-1, dof)
+    if not np.all(np.isfinite(q)):
+        raise InputError(f"{name}: contains NaN or infinite values")
+    return q
+
+
+def _holds_bool(q) -> bool:
+    """True when a (nested) list or tuple holds a boolean: numpy reads [True, 0.5] as float64
+    and the boolean vanishes, so the elements themselves are looked at."""
+    if not isinstance(q, (list, tuple)):
+        return False
+    return any(isinstance(x, (bool, np.bool_)) for x in np.asarray(q, dtype=object).ravel())
+
+
+def check_seed(seed, name: str = "seed"):
+    """A seed numpy's ``default_rng`` takes, else InputError: None (fresh entropy), an integer
+    ≥ 0 or a non-empty sequence of them; booleans are refused (``True`` is no seed)."""
+    if seed is None:
+        return None
+    items = seed if isinstance(seed, (list, tuple)) and seed else [seed]
+    for x in items:
+        if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)) or x < 0:
+            raise InputError(
+                f"{name}: expected None, an integer ≥ 0 or a list of them, got {seed!r}"
+            )
+    return seed
+
+
+def make_rng(seed, name: str = "seed") -> np.random.Generator:
+    """The generator of ``seed``: a ``numpy.random.Generator`` itself (drawn from directly, its
+    stream continues, as ``np.random.default_rng(generator)`` does), else
+    ``np.random.default_rng`` of a seed :func:`check_seed` allows (InputError otherwise)."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    return np.random.default_rng(check_seed(seed, name))
+
+
+__all__ = ["as_batch", "check_seed", "first_outside", "make_rng"]

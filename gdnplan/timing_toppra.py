@@ -1,0 +1,147 @@
+"""The ``smooth`` timing of :mod:`gdnplan.timing`: toppra's time-optimal s(t) along the PCHIP
+curve through the waypoints, and proven bounds of |q̇| and |q̈| over every grid cell
+(:func:`cell_bounds`) that set the time stretch c making the limits hold between grid points.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import InputError
+from .timing_profiles import SmoothProfile
+
+GRID_PER_SEGMENT = 8  # toppra grid cells per waypoint segment (fewer above MAX_GRID)
+MAX_GRID = 4000  # toppra grid points at most
+BEFORE_KNOT = (1e-6, 1e-3, 1e-2, 0.0)  # grid points this share of a segment before inner knots
+STRETCH_SLACK = 1e-9  # c is raised by this fraction (rounding of the cell bounds)
+
+
+def chord_knots(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Cumulative chord length of the distinct waypoints (K,) and each waypoint's knot (T,)."""
+    keep = np.concatenate([[True], np.any(np.diff(q, axis=0) != 0, axis=1)])
+    index = np.cumsum(keep) - 1
+    distinct = q[keep]
+    knots = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(distinct, axis=0), axis=1))])
+    return knots, index
+
+
+def toppra_profile(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> SmoothProfile | None:
+    """toppra's time-optimal s(t) on ``curve``; None when toppra finds no parametrisation."""
+    import logging
+
+    try:
+        import toppra  # noqa: F401  (imported for use in _toppra_on_grid)
+    except ImportError as e:  # PyPI has toppra wheels for Linux x86-64 only
+        raise InputError(
+            f"max_acceleration: the smooth timing needs toppra ({e}); pip install toppra, "
+            "or time the plan without max_acceleration"
+        ) from e
+
+    logging.getLogger("toppra").setLevel(logging.ERROR)
+    segments = len(knots) - 1
+    m = max(2, min(GRID_PER_SEGMENT, MAX_GRID // (2 * segments)))
+    cells = np.linspace(0.0, 1.0, m + 1)[:-1]
+    cells = (knots[:-1, None] + cells[None] * np.diff(knots)[:, None]).ravel()
+    for offset in BEFORE_KNOT:  # the closest first; toppra may call a grid uncontrollable
+        before = knots[1:-1] - offset * np.diff(knots)[:-1]  # p'' jumps at every knot
+        grid = np.unique(np.concatenate([cells, before if offset else [], knots[-1:]]))
+        prof = _toppra_on_grid(curve, knots, grid, v, a)
+        if prof is not None:
+            return prof
+    return None
+
+
+def _toppra_on_grid(curve, knots, grid, v, a) -> SmoothProfile | None:
+    """toppra on one grid (None when it finds no parametrisation); the time stretch c makes
+    the limits hold on every cell whatever the grid (:func:`cell_bounds`)."""
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint as tc
+    from toppra.algorithm.algorithm import ParameterizationReturnCode
+
+    class Path(toppra.interpolator.AbstractGeometricPath):
+        dof = curve.c.shape[2]
+        path_interval = np.array([knots[0], knots[-1]])
+
+        def __call__(self, s, order=0):
+            return curve(s, order)
+
+    constraints = [
+        tc.JointVelocityConstraint(np.column_stack([-v, v])),
+        tc.JointAccelerationConstraint(
+            np.column_stack([-a, a]), discretization_scheme=tc.DiscretizationType.Interpolation
+        ),
+    ]
+    algo = toppra.algorithm.TOPPRA(constraints, Path(), gridpoints=grid)
+    algo.compute_parameterization(0.0, 0.0)
+    data = algo.problem_data
+    sd = data.sd_vec
+    if data.return_code != ParameterizationReturnCode.Ok or sd is None:
+        return None
+    sd = np.maximum(np.asarray(sd, float), 0.0)
+    if not np.all(np.isfinite(sd)) or np.any(sd[1:] + sd[:-1] <= 0):
+        return None
+    prof = SmoothProfile(curve, grid, sd)
+    vel, acc = cell_bounds(curve, grid, sd, prof.u)
+    worst = max(float(np.max(vel / v)), math.sqrt(float(np.max(acc / a))))
+    prof.c = max(1.0, worst * (1.0 + STRETCH_SLACK))
+    return prof
+
+
+def max_abs_quadratic(a2, a1, a0, h0, h1):
+    """max |a2 h² + a1 h + a0| over h ∈ [h0, h1] (elementwise): the ends and the vertex."""
+
+    def f(h):
+        return (a2 * h + a1) * h + a0
+
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = np.where(a2 != 0, -a1 / (2 * a2), h0)
+    inside = (vertex > h0) & (vertex < h1)
+    ends = np.maximum(np.abs(f(h0)), np.abs(f(h1)))
+    return np.where(inside, np.maximum(ends, np.abs(f(np.where(inside, vertex, h0)))), ends)
+
+
+def cell_bounds(curve, grid: np.ndarray, sd: np.ndarray, u: np.ndarray, split: int = 8):
+    """Upper bounds (cells, dof) of |q̇_j| and |q̈_j| over each grid cell [s_i, s_{i+1}].
+
+    In a cell w = ṡ² is linear in s (s̈ = u constant). Each cell is cut into ``split`` equal
+    pieces [a, b], inside one cubic piece p_j(h) = c3 h³ + c2 h² + c1 h + c0 of the PCHIP curve
+    (h = s − its knot; the grid holds every knot; p'' jumps at knots, so each piece uses its
+    own cubic). On [a, b], with w = W0 + 2u h:
+
+        |q̇_j| = |p'_j| ṡ ≤ max |p'_j| · max(ṡ(a), ṡ(b))        (p'_j: a quadratic in h)
+        q̈_j = p''_j w + p'_j u = 15 u c3 h² + 6 (c3 W0 + u c2) h + 2 c2 W0 + u c1
+
+    — a quadratic in h, so max |q̈_j| is exact (its ends and its vertex). Finer pieces make the
+    velocity bound tighter, never unsafe.
+    """
+    cells = len(grid) - 1
+    frac = np.linspace(0.0, 1.0, split + 1)
+    s = grid[:-1, None] + frac[None] * np.diff(grid)[:, None]  # (cells, split + 1)
+    w = np.maximum(sd[:-1, None] ** 2 + 2 * u[:, None] * (s - grid[:-1, None]), 0.0)
+    cell_piece = np.searchsorted(curve.x, grid[:-1], side="right") - 1
+    piece = np.repeat(np.clip(cell_piece, 0, len(curve.x) - 2), split)
+    c3, c2, c1 = curve.c[0, piece], curve.c[1, piece], curve.c[2, piece]  # (cells·split, dof)
+    h0 = (s[:, :-1].ravel() - curve.x[piece])[:, None]
+    h1 = (s[:, 1:].ravel() - curve.x[piece])[:, None]
+    uu = np.repeat(u, split)[:, None]
+    w0 = w[:, :-1].ravel()[:, None] - 2 * uu * h0  # W0: w = W0 + 2u h on the piece
+    top = np.sqrt(np.maximum(w[:, :-1], w[:, 1:]).ravel())[:, None]
+    vel = max_abs_quadratic(3 * c3, 2 * c2, c1, h0, h1) * top
+    acc = max_abs_quadratic(15 * uu * c3, 6 * (c3 * w0 + uu * c2), 2 * c2 * w0 + uu * c1, h0, h1)
+    dof = c1.shape[1]
+    return vel.reshape(cells, split, dof).max(1), acc.reshape(cells, split, dof).max(1)
+
+
+__all__ = [
+    "BEFORE_KNOT",
+    "GRID_PER_SEGMENT",
+    "MAX_GRID",
+    "STRETCH_SLACK",
+    "cell_bounds",
+    "chord_knots",
+    "max_abs_quadratic",
+    "toppra_profile",
+]
