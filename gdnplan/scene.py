@@ -34,6 +34,7 @@ from .geometry import (
     limit_vertices,
     square,
 )
+from .limits import check_int
 from .registry import SCENES
 from .robot import Robot, factory_options, load_robot, robot_names, robot_options
 from .scene_checks import (
@@ -139,8 +140,7 @@ def scene_options(name: str) -> set[str]:
 
 def make_scene(name: str, seed: int = 0, **options) -> Scene:
     """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
+    check_int(seed, "seed", 0)
     return SCENES.get(name)(seed=seed, **options)
 
 

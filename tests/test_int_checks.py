@@ -58,3 +58,12 @@ def test_every_former_copy_uses_it():
     assert (config.batch, config.seed) == (8, 3) and type(config.seed) is int
     with pytest.raises(InputError, match=r"^epochs: expected an integer ≥ 1, got 0$"):
         FitConfig(epochs=0)
+
+
+@pytest.mark.parametrize("seed", [-1, True, 1.5, "0"], ids=repr)
+def test_make_scene_seeds_use_it(seed):
+    from gdnplan.scene import make_scene
+
+    with pytest.raises(InputError, match=r"^seed: expected an integer ≥ 0, got "):
+        make_scene("a", seed=seed)
+    assert make_scene("a", seed=np.int64(3)).seed == 3

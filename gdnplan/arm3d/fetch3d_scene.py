@@ -186,8 +186,7 @@ def fetch3d(seed: int = 0, placement: Placement | None = None, max_tries: int = 
     ``max_tries`` draws. A given ``placement`` places the seed's storage there (no redraw):
     InputError when it is off the table, InfeasibleProblemError when out of reach.
     """
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InputError(f"seed: expected an integer ≥ 0, got {seed!r}")
+    check_int(seed, "seed", 0)
     check_int(max_tries, "max_tries", 1, MAX_TRIES)
     rng = np.random.default_rng(seed)
     error: InfeasibleProblemError | None = None
