@@ -16,9 +16,20 @@ is at least their mean:
     d(q(s)) ≥ L(q_a, q_b) = (d_a + d_b − δ) / 2     for every s ∈ [0, 1] when L ≥ 0.   (1)
 
 coal's distances are GJK estimates that stop once the estimate is within a tolerance τ of the
-separating-plane lower bound, d_coal − d ≤ τ (1 + d_coal) (DistanceRequest.gjk_tolerance); the
-certificate uses the proven lower bound d̲ = d_coal − ``COAL_SLACK`` (1 + |d_coal|) in place of d,
-with ``COAL_SLACK`` = 2 τ. (A test compares coal with shapely's exact planar distances.)
+separating-plane lower bound (DistanceRequest.gjk_tolerance). GJK runs on the shapes' cores —
+a sphere's centre, a capsule's segment, any shape less its swept-sphere radius — and coal
+subtracts the radii ρ = ρ₁ + ρ₂ of the pair afterwards, so the relative tolerance applies to
+the cores' distance d + ρ:
+
+    d_coal − d ≤ τ (1 + |d_coal| + ρ)                                           (m)
+
+(a capsule of radius 50 m overestimated by 2.9e-5 m ≈ 0.6 τ (1 + d + ρ) at d ≈ 0.05 m, 14 times
+τ (1 + d)). The certificate uses the proven lower bound d̲ = d_coal − ``COAL_SLACK``
+(1 + |d_coal| + ρ̄) in place of d (:func:`proven_distance`), with ``COAL_SLACK`` = 2 τ and ρ̄ ≥ ρ
+of every pair the scene has (0 for the planar prisms, which have no swept radius; 3-D:
+:attr:`gdnplan.arm3d.narrow3d.PairTable.swept_max`). d̲ is increasing in d_coal, so the bound
+of the smallest distance is the smallest of the pairs' bounds. (Tests compare coal with
+shapely's exact planar distances and with exact capsule–cylinder distances.)
 
 :func:`certify_path` splits every waypoint segment into pieces and bisects (all open pieces per
 round, one batched coal call) until every piece is proven by (1) to stay above the margin — or
@@ -90,12 +101,17 @@ def motion_bound(
     return delta if per_link else delta.max(axis=1)
 
 
-def proven_distance(d_coal: np.ndarray) -> np.ndarray:
-    """Lower bound d̲ = d_coal − COAL_SLACK (1 + |d_coal|) on the exact distance (m); +inf (no
-    obstacles) stays +inf."""
+def proven_distance(d_coal: np.ndarray, swept: float = 0.0) -> np.ndarray:
+    """Lower bound d̲ = d_coal − COAL_SLACK (1 + |d_coal| + swept) on the exact distance (m);
+    +inf (no obstacles) stays +inf.
+
+    ``swept`` (m, ≥ 0): at least the sum of the swept-sphere radii (sphere and capsule radii)
+    of the pair that gave d_coal (module docstring); 0 for shapes without one.
+    """
     d_coal = np.asarray(d_coal, float)
     finite = np.where(np.isposinf(d_coal), 0.0, d_coal)
-    return np.where(np.isposinf(d_coal), np.inf, finite - COAL_SLACK * (1.0 + np.abs(finite)))
+    slack = COAL_SLACK * (1.0 + np.abs(finite) + swept)
+    return np.where(np.isposinf(d_coal), np.inf, finite - slack)
 
 
 @dataclass(frozen=True)
@@ -210,14 +226,17 @@ def certify_by_bisection(
     min_splits: int,
     stop_early: bool,
     max_checks: int,
+    swept: float = 0.0,
 ) -> Certificate:
     """The bisection proof behind :func:`certify_path`, for any robot and distance.
 
-    ``distance(q)`` (B, dof) → (B,) is the exact signed distance (m) and ``motion(qa, qb)``
-    bounds how far any point of the robot moves between qa and qb (B, dof) → (B,) (m); a piece
-    is proven when (d_a + d_b − motion) / 2 > margin (and within ``tol`` of the smallest checked
-    distance), else it is bisected. Arguments are checked by the caller; ``n_checks`` stays
-    within ``max_checks`` (:func:`_over_budget` before the first call).
+    ``distance(q)`` (B, dof) → (B,) is coal's signed distance (m), made a proven lower bound by
+    :func:`proven_distance` with ``swept`` (m: the largest swept-sphere radius sum of a pair),
+    and ``motion(qa, qb)`` bounds how far any point of the robot moves between qa and qb
+    (B, dof) → (B,) (m); a piece is proven when (d_a + d_b − motion) / 2 > margin (and within
+    ``tol`` of the smallest checked distance), else it is bisected. Arguments are checked by
+    the caller; ``n_checks`` stays within ``max_checks`` (:func:`_over_budget` before the first
+    call).
     """
     failed = _over_budget(len(q_path), min_splits, max_checks)
     if failed is not None:
@@ -225,7 +244,7 @@ def certify_by_bisection(
     qa, qb, seg = _initial_pieces(q_path, min_splits)
     nodes = np.concatenate([qa, qb[-1:]])
     raw = distance(nodes)
-    d_nodes = proven_distance(raw)
+    d_nodes = proven_distance(raw, swept)
     da, db = d_nodes[:-1], d_nodes[1:]
     n_checks, best, raw_min = len(nodes), float(np.min(d_nodes)), float(np.min(raw))
     lower, bad, reasons = math.inf, set(), []
@@ -254,7 +273,7 @@ def certify_by_bisection(
         qa, qb, da, db, seg = qa[keep], qb[keep], da[keep], db[keep], seg[keep]
         mid = (qa + qb) / 2
         raw = distance(mid) if len(mid) else np.zeros(0)
-        dm = proven_distance(raw)
+        dm = proven_distance(raw, swept)
         n_checks += len(mid)
         if len(dm):
             best, raw_min = min(best, float(np.min(dm))), min(raw_min, float(np.min(raw)))

@@ -11,7 +11,8 @@ included, contact-only pairs with the offset of :mod:`gdnplan.arm3d.ccd3d`). A
 straight piece has ∫|q̇_j| = |Δq_j|; a cubic
 piece p_j(s), s ∈ [s_a, s_b], has the total variation TV_j = Σ_i |p_j(x_{i+1}) − p_j(x_i)| over
 x = s_a, the roots of the quadratic p'_j inside the piece, s_b (exact: p_j is monotone between
-them). With d̲ the proven coal distance at the piece's ends (:func:`gdnplan.ccd.proven_distance`),
+them). With d̲ the proven coal distance at the piece's ends (:func:`gdnplan.ccd.proven_distance`,
+with the scene's swept radius :func:`gdnplan.exact.swept_radius_of`),
 
     d(p(s)) ≥ (d̲(p(s_a)) + d̲(p(s_b)) − δ) / 2     for every s ∈ [s_a, s_b],
 
@@ -30,7 +31,7 @@ import numpy as np
 
 from .ccd import MAX_CHECKS, MAX_SPLITS, MIN_PIECE, proven_distance
 from .errors import InputError
-from .exact import exact_distance, motion_bound_of
+from .exact import exact_distance, motion_bound_of, swept_radius_of
 from .limits import check_int, check_number
 from .scene import check_scene
 
@@ -107,7 +108,8 @@ def certify_curve(
     nodes = np.unique((x[:-1, None] + s[None] * np.diff(x)[:, None]).ravel())
     nodes = np.unique(np.concatenate([nodes, x]))
     q_nodes = robot.check_q(curve(nodes), "curve")
-    d = proven_distance(exact_distance(scene, q_nodes, margin=margin))
+    swept = swept_radius_of(scene)
+    d = proven_distance(exact_distance(scene, q_nodes, margin=margin), swept)
     sa, sb, da, db = nodes[:-1], nodes[1:], d[:-1], d[1:]
     n_checks, lower, best = len(nodes), math.inf, float(np.min(d))
     while len(sa):
@@ -123,7 +125,8 @@ def certify_curve(
             return CurveCertificate(False, -math.inf, n_checks)
         sa, sb, da, db = sa[keep], sb[keep], da[keep], db[keep]
         mid = (sa + sb) / 2
-        dm = proven_distance(exact_distance(scene, curve(mid), margin=margin)) if len(mid) else mid
+        raw = exact_distance(scene, curve(mid), margin=margin) if len(mid) else mid
+        dm = proven_distance(raw, swept)
         n_checks += len(mid)
         best = min(best, float(np.min(dm))) if len(dm) else best
         sa, sb = np.concatenate([sa, mid]), np.concatenate([mid, sb])

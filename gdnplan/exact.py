@@ -8,6 +8,7 @@ function            planar ``Scene``             3-D ``Scene3D``
 ``certify``         ``ccd.certify_path``         ``arm3d.certify_path3d``
 ``motion_bound_of`` ``ccd.motion_bound``         ``arm3d.motion_bound3d``
 ``closest_pair``    the closest link             the closest pair (self pairs too)
+``swept_radius_of`` 0 (prisms)                   largest sphere/capsule radius sum
 =================== ============================ ==================================
 
 Both scene kinds also share the attributes the planner reads: ``scene.robot`` with ``dof``,
@@ -124,6 +125,24 @@ def _(robot: Robot3D, qa, qb) -> np.ndarray:
 
 
 @singledispatch
+def swept_radius_of(scene) -> float:
+    """The largest sum of swept-sphere radii of a pair of the scene (m): what
+    :func:`gdnplan.ccd.proven_distance` adds to coal's relative slack (0 for planar prisms;
+    3-D: sphere and capsule radii, :attr:`gdnplan.arm3d.narrow3d.PairTable.swept_max`)."""
+    raise _unknown(scene, "scene")
+
+
+@swept_radius_of.register
+def _(scene: Scene) -> float:
+    return 0.0
+
+
+@swept_radius_of.register
+def _(scene: Scene3D) -> float:
+    return checker3d(scene).swept_max
+
+
+@singledispatch
 def closest_pair(scene, q, margin: float | None = None) -> str:
     """What is closest at one configuration q (dof,), for messages: ``"link 'a' and obstacle
     3"`` (planar) or ``"forearm_link/... and box4"`` (3-D, self pairs name both links);
@@ -150,4 +169,4 @@ def _(scene: Scene3D, q, margin: float | None = None) -> str:
     return f"{a} and {b}" + (" (self-collision)" if checker.is_self[pair] else "")
 
 
-__all__ = ["certify", "closest_pair", "exact_distance", "motion_bound_of"]
+__all__ = ["certify", "closest_pair", "exact_distance", "motion_bound_of", "swept_radius_of"]

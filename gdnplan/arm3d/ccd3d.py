@@ -19,7 +19,9 @@ rigidly), so it changes by at most
 S_σ the joints supporting σ's body (on a chain one shape's joints contain the other's, and
 δ_στ ≤ max(δ_σ, δ_τ)). The distance of any pair changes by at most
 Δ = max(max_σ δ_σ, max_{(σ,τ) self pairs} δ_στ). As in :mod:`gdnplan.ccd`, with proven
-lower bounds d̲_a, d̲_b at the ends (coal's estimate minus ``COAL_SLACK`` (1 + |d|)),
+lower bounds d̲_a, d̲_b at the ends (coal's estimate minus ``COAL_SLACK`` (1 + |d| + ρ̄), ρ̄ the
+largest swept-sphere radius sum of a pair, :attr:`~gdnplan.arm3d.narrow3d.PairTable.swept_max`:
+coal's tolerance is relative to the distance of the pair's cores, a capsule's segment),
 
     d(q(s)) ≥ L = (d̲_a + d̲_b − Δ) / 2      for every s ∈ [0, 1],                    (1)
 
@@ -36,7 +38,7 @@ contact-only pairs and 0 on every other pair (:mod:`gdnplan.arm3d.narrow3d`), an
 
 o_k is constant, so c changes along a piece by at most Δ as every d_k does and (1) holds for c
 unchanged. coal's allowance stays valid: a checked c > M ≥ 0 has d_k > 0 on contact-only pairs,
-so |d_k + o_k| ≥ |d_k| and COAL_SLACK (1 + |c|) covers them. The reported ``lower_bound`` is a
+so |d_k + o_k| ≥ |d_k| and COAL_SLACK (1 + |c| + ρ̄) covers them. The reported ``lower_bound`` is a
 proven lower bound on c: on the obstacle and ordinary self clearance, and with
 ``lower_bound − margin`` (> 0 when ``ok``) on the contact-only pairs' distances;
 ``min_distance`` is the smallest checked c. :class:`Certificate3D` names the contact-only
@@ -175,6 +177,7 @@ def certify_path3d(
         min_splits,
         bool(stop_early),
         max_checks,
+        checker.swept_max,
     )
     pairs = tuple(sorted("–".join(sorted(p)) for p in robot.contact_only))
     return Certificate3D(**vars(cert), margin=float(margin), contact_only=pairs)

@@ -22,6 +22,12 @@ contact-only pairs out; 0 gives the true signed distances.
 Broad-phase bounds: every shape has a bounding sphere (centre c, radius r, from coal's local
 AABB), so d_k ≥ b_k = |c₁ − c₂| − r₁ − r₂ (:meth:`PairTable.placements_batch`).
 
+coal's accuracy: GJK runs on the shapes' cores (a sphere's centre, a capsule's segment, a shape
+less its swept-sphere radius) and subtracts the swept radii ρ_k = ρ₁ + ρ₂ afterwards, so its
+relative tolerance τ bounds d̂_k − d_k ≤ τ (1 + |d̂_k| + ρ_k) (:mod:`gdnplan.ccd`), not
+τ (1 + |d̂_k|): :attr:`PairTable.swept_max` = max_k ρ_k is what the certificates add to their
+slack (:func:`gdnplan.ccd.proven_distance`).
+
 coal conventions handled here:
 
 * an obstacle that is a coal ``OcTree`` (a point cloud as voxels): coal returns its witness
@@ -77,6 +83,13 @@ class PairTable:
         self.radius_sum = (
             self.shape_radius[self.pair_a] + np.r_[obs_radius[obs[:, 1]], self.shape_radius[self_b]]
         )
+        obs_swept = [swept_radius(o.shape) for o in scene.obstacles]
+        shape_swept = np.array([swept_radius(s.shape) for s in robot.shapes])
+        swept = (
+            shape_swept[self.pair_a]
+            + np.r_[np.asarray(obs_swept, float)[obs[:, 1]], shape_swept[self_b]]
+        )
+        self.swept_max = float(np.max(swept, initial=0.0))  # m, the largest ρ_k (module doc)
         self.functors = [
             coal.ComputeDistance(
                 robot.shapes[a].shape,
@@ -187,6 +200,14 @@ class PairTable:
         return out, narrow
 
 
+def swept_radius(shape) -> float:
+    """The radius (m) coal sweeps around ``shape``'s core after GJK: a sphere's or a capsule's
+    radius, plus the shape's own swept-sphere radius (0 unless set); 0 for an octree."""
+    core = float(shape.radius) if isinstance(shape, (coal.Sphere, coal.Capsule)) else 0.0
+    own = shape.getSweptSphereRadius() if hasattr(shape, "getSweptSphereRadius") else 0.0
+    return core + float(own)
+
+
 def check_cap(cap) -> float:
     """``cap`` as a float (m; inf allowed), InputError when it is not a number or NaN."""
     try:
@@ -212,4 +233,4 @@ def check_offset(contact_offset) -> float:
     return value
 
 
-__all__ = ["PairTable", "check_cap", "check_offset"]
+__all__ = ["PairTable", "check_cap", "check_offset", "swept_radius"]
