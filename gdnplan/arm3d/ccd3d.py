@@ -9,7 +9,10 @@ the lever arms r_{σ,j} ≥ |p − o_j|, rigid bounds valid at every configurati
 
 with t_i the fixed translation of joint i in its parent's frame (the distance between
 consecutive joint origins), c_σ the shape's bounding-sphere centre in body b's joint frame and
-ρ_σ its radius; r_{σ,j} = 0 for joints that do not move shape σ. So no point of σ travels farther
+ρ_σ its radius; r_{σ,j} = 0 for joints that do not move shape σ. A prismatic joint j moves
+every point below it by a_j Δq_j, |a_j| = 1: r_{σ,j} = 1; one below a revolute joint would
+change |t_i| with its coordinate, and such robots (like any joint kind but these two) are
+refused (:func:`joint_kind`). So no point of σ travels farther
 than δ_σ = Σ_j r_{σ,j} |Δq_j| along the piece. A self pair's distance depends only on the
 relative pose of its two shapes, which joints supporting both do not change (they move both
 rigidly), so it changes by at most
@@ -84,8 +87,10 @@ _ARMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # robot -> its l
 
 
 def lever_arms3d(robot: Robot3D) -> np.ndarray:
-    """(S, dof) bounds r_{σ,j} ≥ |p − o_j| for every point p of shape σ, any q (m); computed
-    once per robot (the certificate asks for them on every bisection round)."""
+    """(S, dof) bounds r_{σ,j} ≥ |∂p/∂q_j| for every point p of shape σ, any q: |p − o_j| (m)
+    for a revolute joint, 1 for a prismatic one (:func:`_lever_arms3d`); computed once per
+    robot (the certificate asks for them on every bisection round). InputError for a joint
+    kind without a proven bound (:func:`joint_kind`)."""
     if robot not in _ARMS:
         arms = _lever_arms3d(robot)
         arms.setflags(write=False)
@@ -93,17 +98,53 @@ def lever_arms3d(robot: Robot3D) -> np.ndarray:
     return _ARMS[robot]
 
 
+_REVOLUTE = ("RX", "RY", "RZ", "RevoluteUnaligned")  # Pinocchio kinds turning about an axis
+_PRISMATIC = ("PX", "PY", "PZ", "PrismaticUnaligned")  # ... sliding along one
+
+
+def joint_kind(model, j: int) -> str:
+    """The kind of joint j: "R" revolute (one coordinate, rad), "P" prismatic (m); InputError
+    for any other kind (continuous joints with two coordinates, helical, mimic, free-flyer):
+    the certificate's motion bound is proven for these two only."""
+    joint = model.joints[j]
+    kind = joint.shortname().removeprefix("JointModel")
+    if joint.nq == joint.nv == 1 and kind in _REVOLUTE:
+        return "R"
+    if joint.nq == joint.nv == 1 and kind in _PRISMATIC:
+        return "P"
+    raise InputError(
+        f"robot: joint {model.names[j]!r} is a {kind} joint; the continuous certificate bounds "
+        "the motion of revolute and prismatic joints only"
+    )
+
+
 def _lever_arms3d(robot: Robot3D) -> np.ndarray:
+    """The arms of :func:`lever_arms3d`: a revolute joint j moves a point p at |p − o_j| per
+    rad, bounded by chaining the fixed joint-to-joint translations |t_i| below j; a prismatic
+    joint moves every point below it by exactly its own travel (1 m per m). A prismatic joint
+    below a revolute one changes that chain's length with its coordinate (no rigid bound):
+    InputError."""
     model = robot.model
     hop = np.array(
         [np.linalg.norm(model.jointPlacements[i].translation) for i in range(model.njoints)]
     )
+    kinds = {j: joint_kind(model, j) for j in range(1, model.njoints)}
     arms = np.zeros((len(robot.shapes), robot.dof))
     for k, s in enumerate(robot.shapes):
         reach = np.linalg.norm(s.placement[:3, :3] @ s.center + s.placement[:3, 3]) + s.radius
         chain = list(model.supports[s.body])[1:]  # joints from the base to b (universe dropped)
         for pos, j in enumerate(chain):
             below = chain[pos + 1 :]  # joints strictly between j and b, and b itself
+            if kinds[j] == "P":
+                arms[k, model.joints[j].idx_v] = 1.0
+                continue
+            sliding = [model.names[i] for i in below if kinds[i] == "P"]
+            if sliding:
+                raise InputError(
+                    f"robot: prismatic joint {sliding[0]!r} lies below revolute joint "
+                    f"{model.names[j]!r}: the lever arm grows with its travel and the "
+                    "continuous certificate has no rigid bound for it"
+                )
             arms[k, model.joints[j].idx_v] = reach + hop[below].sum()
     return arms
 
