@@ -41,20 +41,28 @@ class LinearProfile:
 
 
 class StopProfile:
-    """Rest-to-rest trapezoidal profile σ(t) on every segment q_k + σ Δq_k."""
+    """Rest-to-rest trapezoidal profile σ(t) on every segment q_k + σ Δq_k.
+
+    Per segment, t_v = max_j |Δq_j| / v_j (s: the segment at the velocity limit) and
+    t_a² = max_j |Δq_j| / a_j (s²: 1/σ̈_max). A triangle (t_a² ≥ t_v²) ramps for r = t_a and
+    lasts τ = 2r; a trapezoid ramps for r = t_a²/t_v, cruises at σ̇ = 1/t_v and lasts
+    τ = t_v + r. Each ramp covers h = r / (2 t_p) of the segment (t_p = r for a triangle,
+    t_v for a trapezoid: σ̇_peak = 1/t_p). Velocities and accelerations are formed as
+    Δq / t_p and Δq / t_a², never as σ̇ Δq: σ̇ and σ̈ overflow for denormal steps while
+    those quotients stay within the limits.
+    """
 
     def __init__(self, q: np.ndarray, v: np.ndarray, a: np.ndarray):
         self.q, self.step = q, np.diff(q, axis=0)
         size = np.abs(self.step)
-        with np.errstate(divide="ignore", over="ignore"):  # a tiny step: no motion
-            vs = np.min(v / size, axis=1, initial=np.inf) if len(size) else np.zeros(0)
-            acc = np.min(a / size, axis=1, initial=np.inf) if len(size) else np.zeros(0)
-        moving = np.isfinite(vs)
-        vs, acc = np.where(moving, vs, 1.0), np.where(moving, acc, 1.0)
-        triangle = vs**2 >= acc
-        self.peak = np.where(triangle, np.sqrt(acc), vs)
-        self.acc, self.ramp = acc, self.peak / acc
-        self.tau = np.where(moving, np.where(triangle, 2 * self.ramp, 1 / vs + vs / acc), 0.0)
+        t_v = np.max(size / v, axis=1, initial=0.0)
+        t_a2 = np.max(size / a, axis=1, initial=0.0)
+        triangle = t_a2 >= t_v**2
+        self.ramp = np.where(triangle, np.sqrt(t_a2), _safe_divide(t_a2, t_v))
+        self.t_peak = np.where(triangle, self.ramp, t_v)
+        self.t_a2 = t_a2
+        self.h = np.where(triangle, 0.5, 0.5 * _safe_divide(self.ramp, t_v))
+        self.tau = np.where(triangle, 2 * self.ramp, t_v + self.ramp)
         self.times = np.concatenate([[0.0], np.cumsum(self.tau)])
 
     def state(self, t):
@@ -63,15 +71,30 @@ class StopProfile:
             return self.q[[0] * len(t)], z, z
         k = _segment_of(self.times, t)
         x = np.clip(t - self.times[k], 0.0, self.tau[k])
-        acc, peak, ramp, tau = self.acc[k], self.peak[k], self.ramp[k], self.tau[k]
+        ramp, h, t_peak, tau = self.ramp[k], self.h[k], self.t_peak[k], self.tau[k]
         rest = tau - x
         up, down = x < ramp, rest < ramp
-        sig = np.where(up, 0.5 * acc * x**2, 0.5 * acc * ramp**2 + peak * (x - ramp))
-        sig = np.where(down & ~up, 1.0 - 0.5 * acc * rest**2, sig)
-        sd = np.where(up, acc * x, np.where(down, acc * rest, peak))
-        sdd = np.where(up, acc, np.where(down, -acc, 0.0))
-        sig, sd, sdd = (np.where(tau > 0, y, 0.0)[:, None] for y in (sig, sd, sdd))
-        return self.q[k] + sig * self.step[k], sd * self.step[k], sdd * self.step[k]
+        u, w = _safe_divide(x, ramp), _safe_divide(rest, ramp)
+        sig = np.where(up, h * u**2, h + _safe_divide(x - ramp, t_peak))
+        sig = np.clip(np.where(down & ~up, 1.0 - h * w**2, sig), 0.0, 1.0)
+        speed = np.where(up, u, np.where(down, w, 1.0))
+        sign = np.where(up, 1.0, np.where(down, -1.0, 0.0))
+        step = self.step[k]
+        qd = speed[:, None] * _safe_divide(step, t_peak[:, None])
+        qdd = sign[:, None] * _safe_divide(step, self.t_a2[k][:, None])
+        still = (tau <= 0)[:, None]
+        return (
+            self.q[k] + np.where(still, 0.0, sig[:, None] * step),
+            np.where(still, 0.0, qd),
+            np.where(still, 0.0, qdd),
+        )
+
+
+def _safe_divide(num: np.ndarray, den: np.ndarray) -> np.ndarray:
+    """num / den where den > 0, else 0 (a segment without that phase)."""
+    num, den = np.broadcast_arrays(np.asarray(num, float), np.asarray(den, float))
+    with np.errstate(over="ignore"):
+        return np.divide(num, den, out=np.zeros(num.shape), where=den > 0)
 
 
 class SmoothProfile:

@@ -54,6 +54,7 @@ def _check(traj, q: np.ndarray) -> None:
 @example(v=1e-6, a=1e-6, seed=1, scale=1e5)  # the slowest accepted limits, long steps
 @example(v=1e9, a=1e9, seed=2, scale=1e-300)  # the fastest, denormal-scale steps
 @example(v=1e9, a=None, seed=0, scale=1e-300)  # linear timing: denormal segment times
+@example(v=1e-6, a=1e9, seed=0, scale=1e-300)  # stop timing: σ̈ = a/|Δq| overflows
 def test_extreme_limits_are_refused_or_give_a_finite_trajectory(v, a, seed, scale):
     q = _path(seed, scale)
     low, high = LIMIT_RANGE
