@@ -19,6 +19,8 @@ array (k, 3), or a text file of one point per line, ``x y z`` or ``x, y, z`` (``
 
 from __future__ import annotations
 
+import io
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -26,6 +28,7 @@ import coal
 import numpy as np
 
 from ..errors import InputError
+from ..files import read_input
 from ..limits import is_number
 from .scene3d import Obstacle3D, obstacle
 from .shapes import as_points, existing_file
@@ -89,12 +92,15 @@ def read_cloud(path: Path | str, name: str = "cloud") -> np.ndarray:
     """The (k, 3) points of a ``.npy`` file or a text file of ``x y z`` / ``x, y, z`` lines (m);
     UnknownNameError for a missing file, InputError for one that holds no such points."""
     path = existing_file(path, f"{name}: point file")
+    data = read_input(path, f"{name}: point file")  # a regular file of at most 256 MiB
     try:
         if path.suffix.lower() == ".npy":
-            pts = np.load(path, allow_pickle=False)
+            pts = np.load(io.BytesIO(data), allow_pickle=False)
         else:
-            text = path.read_text(errors="strict").replace(",", " ")
-            pts = np.loadtxt(text.splitlines(), dtype=float, comments="#", ndmin=2)
+            text = data.decode("utf-8").replace(",", " ")
+            with warnings.catch_warnings():  # no data: refused below, with the shape
+                warnings.simplefilter("ignore", UserWarning)
+                pts = np.loadtxt(text.splitlines(), dtype=float, comments="#", ndmin=2)
     except (OSError, ValueError, UnicodeDecodeError) as e:
         first = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(f"{name}: {path.name} is not a point file ({first})") from e

@@ -47,6 +47,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
+from ..files import read_input
 
 
 def srdf_disabled_pairs(srdf: str | Path, model: pin.Model) -> dict[frozenset[str], str]:
@@ -59,7 +60,7 @@ def srdf_disabled_pairs(srdf: str | Path, model: pin.Model) -> dict[frozenset[st
     if not path.is_file():
         raise UnknownNameError(f"srdf: file {path} does not exist (or is not a file)")
     try:
-        root = ET.fromstring(path.read_bytes())
+        root = ET.fromstring(read_input(path, "srdf"))
     except ET.ParseError as e:
         raise InputError(f"srdf: {path} is not a readable XML file ({e})") from e
     out: dict[frozenset[str], str] = {}

@@ -34,6 +34,7 @@ from safetensors.torch import load_file
 
 from ..arm3d.scene3d import Scene3D
 from ..errors import InputError
+from ..files import read_input
 from ..scene import ENV_ROBOT, Scene
 
 FIXED_LAYOUT_ENVS = ("a", "c")  # environments whose obstacles never change (scene.py)
@@ -43,8 +44,10 @@ RETRAIN = "re-download the shipped weights or train them again (gdnplan train)"
 def parse_card(card: Path, what: str = "weights") -> dict:
     """The JSON object in the card file ``card``; InputError when it is unreadable or not one."""
     try:
-        content = json.loads(card.read_bytes().decode("utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as e:
+        content = json.loads(read_input(card, f"{what}: card").decode("utf-8"))
+    except InputError:
+        raise
+    except (UnicodeDecodeError, ValueError, RecursionError) as e:
         raise InputError(f"{what}: card {card} is not valid JSON ({e}); {RETRAIN}") from e
     if not isinstance(content, dict):
         raise InputError(

@@ -20,6 +20,7 @@ from ..arm3d.scene3d import Scene3D
 from ..arm3d.scene_file3d import scene3d_from_config
 from ..assets import problem_file
 from ..errors import InputError, ProblemFileError
+from ..files import read_input
 from ..limits import IPOPT_OPTIONS, is_number
 from ..scene import Scene, no_unknown_keys, scene_from_config
 from .config import CONFIG_TABLES, AdamConfig, IpoptConfig, PlanConfig, config_keys
@@ -48,15 +49,16 @@ HOME["interpolated"] = "ipopt] or [adam"  # in both
 
 def read_problem_file(path: str | Path) -> dict:
     """The parsed TOML mapping of a problem file; ProblemFileError when it cannot be read, is
+    no regular file of at most ``MAX_INPUT_BYTES`` (:func:`gdnplan.files.read_input`), is
     not UTF-8 text, is malformed or nests deeper than Python's parser can follow.
 
     ``path``: a file, or the name of a shipped problem (``"fetch_reach"``).
     """
     path = problem_file(path)
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as e:
-        raise ProblemFileError(f"{path}: cannot read the problem file ({e.strerror})") from e
+        return tomllib.loads(read_input(path, "problem file").decode("utf-8"))
+    except InputError as e:  # missing, a directory, a FIFO or device, larger than 256 MiB
+        raise ProblemFileError(str(e)) from e
     except UnicodeDecodeError as e:
         raise ProblemFileError(f"{path}: not UTF-8 text (byte {e.start}); save it as UTF-8") from e
     except tomllib.TOMLDecodeError as e:

@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
+from ..files import read_input
 from .joint_limits import check_joint_limits, make_continuous_revolute, unlimit_effort
 from .meshes import check_meshes
 from .spec import RobotSpec
@@ -46,7 +47,7 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     if not found:
         raise UnknownNameError(f"urdf: file {path} does not exist (or is not a file)")
     try:
-        root = ET.fromstring(path.read_bytes())
+        root = ET.fromstring(read_input(path, "urdf"))
     except (OSError, ET.ParseError) as e:
         reason = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
@@ -132,7 +133,7 @@ def check_mimic(urdf: str | Path, planning) -> None:
     Pinocchio reads a mimic joint as an independent joint, so gdnplan would plan it on its own
     or hold it locked while its master moves: distances and certificates would be those of
     another robot than the URDF describes."""
-    _check_mimic(ET.fromstring(Path(urdf).read_bytes()), planning, Path(urdf))
+    _check_mimic(ET.fromstring(read_input(urdf, "urdf")), planning, Path(urdf))
 
 
 def _check_mimic(root: ET.Element, planning, path: Path) -> None:

@@ -11,6 +11,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InputError
+from ..files import read_input
 from ..limits import is_number
 
 CONTINUOUS = {"JointModelRUBX", "JointModelRUBY", "JointModelRUBZ"}
@@ -50,8 +51,8 @@ def mimic_relations(urdf: str | Path) -> dict[str, tuple[str, float, float]]:
     """{follower: (master, multiplier, offset)} of the ``<mimic>`` joints of a URDF file
     (follower = multiplier · master + offset); empty when the file cannot be read."""
     try:
-        root = ET.fromstring(Path(urdf).read_bytes())
-    except (OSError, ValueError, ET.ParseError):
+        root = ET.fromstring(read_input(urdf, "urdf"))
+    except (InputError, ValueError, ET.ParseError):
         return {}
     out = {}
     for joint in root.iter("joint"):

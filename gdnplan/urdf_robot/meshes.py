@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..files import check_input_file
 from .stderr import stderr_captured
 from .xml_checks import MAX_OFFSET, mesh_elements, numbers, shown
 
@@ -82,6 +83,7 @@ def mesh_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarray
         raise InputError(f"{where}: {found} is a directory, not a mesh file")
     if not found.is_file():
         raise InputError(f"{where}: {found} is not a regular file (a device or a pipe)")
+    check_input_file(found, where)  # at most MAX_INPUT_BYTES: assimp reads it whole
     vertices = _read_vertices(found, scale, where)
     if len(vertices) == 0:
         raise InputError(f"{where}: {found} has no vertices")
