@@ -160,3 +160,50 @@ def test_load_mesh_refuses_bad_vertices_before_computing_with_them(tmp_path, cap
     with pytest.raises(InputError, match=r"NaN or infinite|beyond"):
         load_mesh(path, name="part")
     assert "eigen" not in capfd.readouterr().err
+
+
+# points: every coordinate a real number; numpy's float conversion turned True into 1.0, "0.5"
+# into 0.5 and 1 + 2j into 1.0 (with a ComplexWarning), so a convex or cloud obstacle of a
+# problem file (or a .npy of another dtype) was built from numbers the user never wrote
+NOT_REAL = st.one_of(
+    st.booleans(),
+    st.floats(-1.0, 1.0).map(str),
+    st.complex_numbers(max_magnitude=1.0),
+    st.none(),
+    st.just([0.1]),
+)
+
+
+@given(
+    points=st.lists(st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3), min_size=1),
+    bad=NOT_REAL,
+    where=st.tuples(st.integers(0, 10**6), st.integers(0, 2)),
+)
+@settings(max_examples=150, deadline=None)
+def test_point_lists_with_a_non_real_coordinate_are_refused(points, bad, where):
+    from gdnplan.arm3d.shapes import as_points
+
+    assert np.array_equal(as_points(points, "p", min_points=1), np.asarray(points, float))
+    row, column = where[0] % len(points), where[1]
+    points[row][column] = bad
+    with pytest.raises(InputError, match=r"^p: expected (real numbers|\(k, 3\))"):
+        as_points(points, "p", min_points=1)
+
+
+@pytest.mark.parametrize(
+    "dtype, kind", [(bool, "booleans"), (complex, "complex numbers"), ("U3", "strings")]
+)
+def test_point_arrays_of_a_non_real_dtype_are_refused(dtype, kind):
+    from gdnplan.arm3d.cloud3d import cloud_obstacle
+
+    with pytest.raises(InputError, match=f"expected real numbers as coordinates, got {kind}"):
+        cloud_obstacle(np.ones((5, 3)).astype(dtype), name="scan")
+    assert cloud_obstacle(np.ones((5, 3), np.float16), name="scan").points.dtype == float
+
+
+@pytest.mark.parametrize("scale", [[True, True, True], ["1", "1", "1"], [1, 1, 1 + 0j]])
+def test_a_mesh_scale_of_non_numbers_is_refused(tmp_path, scale):
+    path = tmp_path / "cube.stl"
+    write_stl(path, CUBE, [(0, 1, 2), (4, 5, 6), (0, 4, 5), (1, 3, 7)])
+    with pytest.raises(InputError, match=r"m\.scale: expected three positive numbers"):
+        load_mesh(path, scale, name="m")

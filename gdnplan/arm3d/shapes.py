@@ -71,11 +71,9 @@ def as_points(
     points, name: str, min_points: int = 4, max_points: int = MAX_HULL_POINTS
 ) -> np.ndarray:
     """A finite, bounded float (k, 3) point array (min_points ≤ k ≤ max_points; the defaults:
-    a convex hull's), else InputError."""
-    try:
-        pts = np.asarray(points, dtype=float)
-    except (TypeError, ValueError) as e:
-        raise InputError(f"{name}: expected points of shape (k, 3), got {type(points)}") from e
+    a convex hull's), else InputError. Coordinates are real numbers: booleans, strings
+    (``"0.5"``), complex numbers and other objects are refused, not converted."""
+    pts = _real_array(points, name)
     if pts.ndim != 2 or pts.shape[1] != 3 or not min_points <= len(pts) <= max_points:
         raise InputError(
             f"{name}: expected (k, 3) points with {min_points} ≤ k ≤ {max_points}, got {pts.shape}"
@@ -87,6 +85,37 @@ def as_points(
             f"{name}: coordinates beyond {MAX_COORDINATE:g} m; use metres near the robot"
         )
     return pts
+
+
+_NOT_REAL = {"b": "booleans", "U": "strings", "S": "bytes", "c": "complex numbers"}
+
+
+def _real_array(points, name: str) -> np.ndarray:
+    """``points`` as a float array when every entry is a real number (numpy kinds integer,
+    unsigned or float; a nested list element by element, where numpy would turn ``True`` into
+    1.0 silently), else InputError naming ``name``."""
+    if isinstance(points, (list, tuple)) or (
+        isinstance(points, np.ndarray) and points.dtype.kind == "O"
+    ):
+        try:
+            items = np.asarray(points, dtype=object)
+        except ValueError as e:  # a ragged nesting numpy cannot hold
+            raise InputError(f"{name}: expected points of shape (k, 3), got a ragged list") from e
+        if items.ndim != 2:  # empty, flat or ragged: the caller refuses the shape
+            return np.zeros(items.shape)
+        bad = [x for x in items.ravel() if not is_number(x)][:1]
+        if bad:
+            shown = bad[0].item() if isinstance(bad[0], np.generic) else bad[0]
+            raise InputError(f"{name}: expected real numbers as coordinates, got {shown!r}")
+        return items.astype(float)
+    try:
+        arr = np.asarray(points)
+    except (TypeError, ValueError, RuntimeError) as e:
+        raise InputError(f"{name}: expected points of shape (k, 3), got {type(points)}") from e
+    if arr.dtype.kind not in "iuf":
+        what = _NOT_REAL.get(arr.dtype.kind, f"an array of {arr.dtype}")
+        raise InputError(f"{name}: expected real numbers as coordinates, got {what}")
+    return arr.astype(float)
 
 
 # -------------------------------------------------------------------- shapes
@@ -193,8 +222,10 @@ def load_mesh(path, scale=(1.0, 1.0, 1.0), name: str = "mesh") -> coal.ConvexBas
     needs 1e-3). UnknownNameError for a missing file, InputError for one that is not a mesh.
     """
     path = existing_file(path, f"{name}: mesh file")
-    factors = np.asarray(scale, dtype=float)
-    if factors.shape != (3,) or not np.all(np.isfinite(factors)) or np.any(factors <= 0):
+    items = np.asarray(scale, dtype=object)
+    ok = items.shape == (3,) and all(is_number(x) for x in items)
+    factors = items.astype(float) if ok else np.zeros(3)
+    if not ok or not np.all(np.isfinite(factors)) or np.any(factors <= 0):
         raise InputError(f"{name}.scale: expected three positive numbers, got {scale!r}")
     # read and checked (finite, bounded) before anything computes with them: coal's own
     # loader prints "eigen: too many iterations" for a NaN vertex
