@@ -26,7 +26,7 @@ import numpy as np
 
 from .ccd import Certificate, proven_distance
 from .errors import InputError
-from .exact import certify, exact_distance
+from .exact import certify, exact_distance, swept_radius_of
 from .limits import check_number
 from .robot import as_batch, first_outside
 from .rrt import edge_free
@@ -98,6 +98,7 @@ def _setup(ob, scene: Scene, lower: np.ndarray, upper: np.ndarray, clearance: fl
         bounds.setHigh(j, float(upper[j]))
     space.setBounds(bounds)
     si = ob.SpaceInformation(space)
+    swept = swept_radius_of(scene)
 
     def vector(state) -> np.ndarray:
         return np.array([state[j] for j in range(dof)])
@@ -106,7 +107,8 @@ def _setup(ob, scene: Scene, lower: np.ndarray, upper: np.ndarray, clearance: fl
         q = vector(state)
         if np.any(q < lower) or np.any(q > upper):
             return False
-        return bool(proven_distance(exact_distance(scene, q))[0] > clearance)
+        d = exact_distance(scene, q, margin=clearance)  # 3-D contact-only pairs: d + clearance
+        return bool(proven_distance(d, swept)[0] > clearance)
 
     class CertifiedMotion(ob.MotionValidator):
         def checkMotion(self, a, b) -> bool:  # OMPL's name

@@ -22,3 +22,24 @@ def test_an_ompl_path_in_3d_is_certified():
     np.testing.assert_array_equal(result.path[-1], GOAL)
     assert result.clearance > 0.02
     assert certify_path3d(scene, result.path, 0.02).ok  # independently of plan_ompl's own
+
+
+def test_ompl_states_hold_contact_only_pairs_at_zero():
+    """OMPL's state checker is the certificate's: a UR5e configuration with the wrist inside
+    the forearm (a contact-only pair, true d < 0) is invalid at any clearance, one clear of
+    everything at a clearance below its distance is valid."""
+    from ompl import base as ob
+
+    from gdnplan.arm3d import signed_distance3d
+    from gdnplan.ompl_planner import _setup
+
+    robot = load_robot3d("ur5e")
+    scene = Scene3D(robot, [])
+    inside = np.array([0.0, -1.6902, 0.5121, 1.4892, -2.4591, -3.2126])
+    assert signed_distance3d(scene, inside)[0] < -0.005
+    si, _, _ = _setup(ob, scene, robot.lower, robot.upper, 0.0)
+    for q, valid in ((inside, False), (START, True)):
+        state = si.allocState()
+        for j, value in enumerate(q):
+            state[j] = float(value)
+        assert si.isValid(state) is valid

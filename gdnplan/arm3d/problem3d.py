@@ -59,10 +59,11 @@ def _draw_pair(scene: Scene3D, rng: np.random.Generator, margin: float, box):
     """(start, goal) in the joint box clear of the margin with a colliding straight line, or
     None."""
     s = np.linspace(0.0, 1.0, LINE_SAMPLES)[:, None]
+    swept = checker3d(scene).swept_max
     for _ in range(MAX_DRAWS):
         ends = rng.uniform(box[0], box[1], (2, len(box[0])))
         d = checker3d(scene).evaluate(ends, contact_offset=margin).distance  # contact-only: d ≥ 0
-        if np.any(d <= margin) or np.any(proven_distance(d) <= margin):
+        if np.any(d <= margin) or np.any(proven_distance(d, swept) <= margin):
             continue
         line = ends[0] + s * (ends[1] - ends[0])
         if np.min(signed_distance3d(scene, line)) <= 0.0:

@@ -20,7 +20,7 @@ from ..arm3d.scene_file3d import pose_goal
 from ..assets import problem_file
 from ..ccd import proven_distance
 from ..errors import InfeasibleProblemError, InputError, ProblemFileError
-from ..exact import closest_pair, exact_distance
+from ..exact import closest_pair, exact_distance, swept_radius_of
 from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number
 from ..robot import first_outside
 from ..scene import Scene
@@ -188,7 +188,8 @@ class Problem:
                     f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
                 )
             d = float(exact_distance(self.scene, q, margin=self.margin)[0])
-            if d <= self.margin or proven_distance(d) <= self.certified_clearance:
+            swept = swept_radius_of(self.scene)
+            if d <= self.margin or proven_distance(d, swept) <= self.certified_clearance:
                 raise InfeasibleProblemError(
                     f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m between "
                     f"{closest_pair(self.scene, q, margin=self.margin)}; move it away or lower "
