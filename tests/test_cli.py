@@ -405,3 +405,19 @@ def test_fetch_stage_lines_state_what_each_certificate_proves():
     text = stage_clearance(lift)
     assert text.startswith("certified clearance ≥ +0.0017 m from waypoint 1 on")
     assert "+0.0000 m before it" in text
+
+
+def test_a_plan_without_obstacles_says_so_not_that_its_clearance_is_unproven(tmp_path):
+    # min_distance is +inf when there is nothing to collide with; the text said "clearance not
+    # proven" beside "certified collision-free" (−inf is the bound of a failed certificate)
+    from gdnplan.cli.plan import clearance_text
+
+    problem = tmp_path / "free.toml"
+    problem.write_text(
+        '[robot]\nname = "planar2"\n\n[start]\nq = [0.5, 0.5]\n\n[goal]\nq = [1.5, 0.5]\n'
+    )
+    result = CliRunner().invoke(app, ["plan", str(problem), "--collision", "coal", "-q"])
+    assert result.exit_code == 0, result.output
+    assert "certified collision-free; nothing to collide with (no obstacles)" in result.output
+    assert clearance_text(float("-inf")) == clearance_text(float("nan")) == "clearance not proven"
+    assert clearance_text(0.0123) == "certified clearance ≥ +0.0123 m"

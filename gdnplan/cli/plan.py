@@ -255,7 +255,10 @@ def timing_text(traj) -> str:
 
 
 def clearance_text(lower_bound: float) -> str:
-    """'certified clearance ≥ +0.0123 m', or 'clearance not proven' for a −inf bound."""
+    """'certified clearance ≥ +0.0123 m'; 'nothing to collide with' for a +inf bound (no
+    obstacles, no self-collision pairs), 'clearance not proven' for −inf (or NaN)."""
+    if lower_bound == math.inf:
+        return "nothing to collide with (no obstacles)"
     if not math.isfinite(lower_bound):
         return "clearance not proven"
     return f"certified clearance ≥ {lower_bound:+.4f} m"
