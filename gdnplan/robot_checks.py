@@ -27,12 +27,17 @@ def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
 
     InputError naming ``name`` unless q holds real numbers (numpy kinds integer, unsigned or
     float): booleans, strings, complex numbers and other objects are refused, not coerced
-    (``"0.1"`` is no angle, ``True`` no 1 rad, 1 + 2j loses its imaginary part).
+    (``"0.1"`` is no angle, ``True`` no 1 rad, 1 + 2j loses its imaginary part), and so are a
+    masked array with masked entries (numpy would read the hidden values) and a torch tensor
+    that requires grad (the distance functions return numpy: detach it first).
     """
+    if isinstance(q, np.ma.MaskedArray) and np.ma.is_masked(q):
+        raise InputError(f"{name}: masked entries are no joint angles; fill them (q.filled(…))")
     try:
         arr = np.asarray(q)
-    except (TypeError, ValueError) as e:
-        raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from e
+    except (TypeError, ValueError, RuntimeError) as e:  # RuntimeError: torch's requires_grad
+        hint = "; a torch tensor that requires grad: pass q.detach()" if _needs_grad(q) else ""
+        raise InputError(f"{name}: expected numbers, got {type(q).__name__}{hint}") from e
     if arr.dtype.kind not in "iuf" or _holds_bool(q):
         kind = "b" if arr.dtype.kind in "iuf" else arr.dtype.kind
         what = _KINDS.get(kind, f"an array of {arr.dtype}")
@@ -43,6 +48,10 @@ def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
     if not np.all(np.isfinite(q)):
         raise InputError(f"{name}: contains NaN or infinite values")
     return q
+
+
+def _needs_grad(q) -> bool:
+    return bool(getattr(q, "requires_grad", False))
 
 
 def _holds_bool(q) -> bool:

@@ -224,3 +224,25 @@ def test_a_bowtie_still_intersects_itself():
     with pytest.raises(gp.InputError, match="intersects itself"):
         as_polygon([[0, 0], [1, 1], [1, 0], [0, 1]])
     assert as_polygon([[0, 0], [1, 0], [0, 1e-6]]).shape == (3, 2)  # thin is not flat
+
+
+@settings(max_examples=40, deadline=None)
+@given(mask=hnp.arrays(np.bool_, (3, 2)), grad=st.booleans())
+def test_masked_entries_and_grad_tensors_are_refused_not_read(mask, grad):
+    """A masked entry is no joint angle (numpy would read the hidden value); a tensor that
+    requires grad names the fix (torch cannot hand it to numpy)."""
+    import torch
+
+    data = np.full((3, 2), 0.3)
+    masked = np.ma.masked_array(data, mask=mask)
+    if mask.any():
+        with pytest.raises(gp.InputError, match=r"^q: masked entries"):
+            gp.signed_distance(PLANAR, masked)
+    else:
+        np.testing.assert_array_equal(as_batch(masked, 2), data)
+    tensor = torch.tensor(data, requires_grad=grad)
+    if grad:
+        with pytest.raises(gp.InputError, match=r"q\.detach\(\)"):
+            gp.signed_distance_and_grad(PLANAR, tensor)
+    else:
+        np.testing.assert_array_equal(as_batch(tensor, 2), data)
