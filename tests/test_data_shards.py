@@ -111,3 +111,24 @@ def test_an_interrupted_shard_leaves_no_temp_and_is_made_on_resume(tmp_path, mon
     monkeypatch.setattr(np, "savez_compressed", real)
     data.generate("a", 6, seed=0, out_dir=tmp_path, workers=1)
     assert len(data.load(tmp_path)) == 6
+
+
+@pytest.mark.parametrize("offset", [0, 1, 2**64])
+def test_split_seeds_are_bounded_so_scene_seeds_stay_64_bit(tmp_path, offset):
+    """Sample i of split seed s draws its scene with seed s · 10⁸ + i (int64): the largest
+    allowed seed works to the last sample of a split, larger ones are InputErrors naming
+    ``seed`` (they overflowed in numpy: OverflowError)."""
+    from gdnplan.data.sampling import split_samples
+    from gdnplan.data.shard_folder import MAX_DATA_SEED, MAX_SPLIT, SCENE_SEED_STRIDE
+
+    assert MAX_DATA_SEED * SCENE_SEED_STRIDE + MAX_SPLIT <= np.iinfo(np.int64).max
+    seed = MAX_DATA_SEED + offset
+    if offset:
+        for call in (
+            lambda: data.generate("d", 1, seed, tmp_path / "x", workers=1),
+            lambda: split_samples("d", seed, 0, 1),
+        ):
+            with pytest.raises(InputError, match=r"^seed: expected an integer in \[0, "):
+                call()
+    else:
+        assert len(split_samples("d", seed, MAX_SPLIT - 1, 1).q) == 1

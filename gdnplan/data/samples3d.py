@@ -59,6 +59,7 @@ from ..arm3d import (
 )
 from ..errors import InputError, UnknownNameError
 from .samples_storage3d import storage_scenes
+from .shard_folder import SCENE_SEED_STRIDE, check_data_seed
 
 ENVS3D = {"ur5e_boxes": "ur5e", "ur5e_cloud": "ur5e", "ur5e_storage": "ur5e"}  # env -> robot
 N_BOXES = 20
@@ -146,6 +147,7 @@ def _near(checker: Checker3D, robot: Robot3D, k: int, rng: np.random.Generator) 
 def make_shard3d(env: str, seed: int, start: int, n: int, near: float = 0.0) -> dict:
     """The arrays (module docstring) of samples ``start … start + n − 1`` of the split of
     ``env`` with ``seed``; ``start`` must be a multiple of SCENE_SAMPLES."""
+    check_data_seed(seed)
     if start % SCENE_SAMPLES:
         raise InputError(f"start: expected a multiple of {SCENE_SAMPLES}, got {start}")
     robot = env_robot3d(env)
@@ -153,7 +155,7 @@ def make_shard3d(env: str, seed: int, start: int, n: int, near: float = 0.0) -> 
     rng = np.random.default_rng([seed, start, 3])
     first = start // SCENE_SAMPLES
     n_scenes = -(-n // SCENE_SAMPLES)
-    seeds = seed * 10**8 + first + np.arange(n_scenes, dtype=np.int64)
+    seeds = seed * SCENE_SEED_STRIDE + first + np.arange(n_scenes, dtype=np.int64)
     cloud = env == "ur5e_cloud"
     if env == "ur5e_storage":
         geometry, scenes = storage_scenes(seeds)

@@ -31,6 +31,7 @@ from ..errors import InputError
 from ..geometry import pad_polygons
 from ..scene import Scene, make_scene
 from .dataset import Dataset, concat
+from .shard_folder import SCENE_SEED_STRIDE, check_data_seed
 from .ur5e_samples import make_ur5e_shard
 
 RANDOM_ENVS = ("b", "d", "e")
@@ -63,7 +64,7 @@ def make_shard(env: str, seed: int, start: int, n: int, near: float = 0.0) -> Da
     base = make_scene(env, seed=0)
     robot = base.robot
     q = robot.sample(n, seed=[seed, start])
-    scene_seed = seed * 10**8 + start + np.arange(n, dtype=np.int64)
+    scene_seed = seed * SCENE_SEED_STRIDE + start + np.arange(n, dtype=np.int64)
     rng = np.random.default_rng([seed, start, 11])
     is_near = rng.random(n) < near if near > 0 else np.zeros(n, bool)
     if env in RANDOM_ENVS:
@@ -99,6 +100,7 @@ def split_samples(env: str, seed: int, start: int, n: int, near: float = 0.0) ->
     the samples of it up to the range's end (or the whole block where a shorter shard is not
     its prefix, :func:`_prefix_consistent`), with the samples before ``start`` dropped.
     """
+    check_data_seed(seed)
     if n < 1 or start < 0:
         raise InputError(f"n: expected n ≥ 1 samples from start ≥ 0, got n = {n}, start = {start}")
     size, end = SHARD_SIZE, start + n

@@ -23,10 +23,12 @@ from tqdm import tqdm
 
 from ..errors import InputError
 from ..files import write_text
-from ..limits import is_number
+from ..limits import check_int, is_number
 
 MANIFEST = "manifest.json"
 MAX_SPLIT = 10**8  # samples of one split: ~15 GB of planar 2-DoF shards, ~110 GB of (e)'s
+SCENE_SEED_STRIDE = 10**8  # sample i of split seed s draws its scene with seed s · stride + i
+MAX_DATA_SEED = (2**63 - 1 - MAX_SPLIT) // SCENE_SEED_STRIDE  # scene seeds stay int64
 MAX_WORKERS = max(64, 4 * (os.cpu_count() or 1))  # processes of one run (four per core)
 
 
@@ -38,10 +40,12 @@ def shard_plan(out_dir: Path | str, n: int, size: int) -> list[tuple[int, int, P
     ]
 
 
-def check_split(n: object, near: object, workers: object = None) -> None:
+def check_split(n: object, near: object, workers: object = None, seed: object = 0) -> None:
     """InputError unless n is an int (not a bool) in 1 … :data:`MAX_SPLIT` (a split's shards
     take ~150 bytes (planar 2-DoF) to ~1.1 kB (environment e) of disk per sample), near a
-    fraction in [0, 1] and workers None or an int in 1 … :data:`MAX_WORKERS`."""
+    fraction in [0, 1], workers None or an int in 1 … :data:`MAX_WORKERS` and seed an
+    integer in [0, :data:`MAX_DATA_SEED`] (:func:`check_data_seed`)."""
+    check_data_seed(seed)
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= MAX_SPLIT:
         raise InputError(
             f"n: expected a number of samples in [1, {MAX_SPLIT:.0e}] (the limit), got {n!r}"
@@ -49,6 +53,12 @@ def check_split(n: object, near: object, workers: object = None) -> None:
     if not is_number(near) or not 0.0 <= near <= 1.0:
         raise InputError(f"near: expected a fraction in [0, 1], got {near!r}")
     check_workers(workers)
+
+
+def check_data_seed(seed: object) -> int:
+    """A split's seed: an integer in [0, :data:`MAX_DATA_SEED`] (its scenes' seeds
+    seed · 10⁸ + i, i < :data:`MAX_SPLIT`, must stay 64-bit integers), else InputError."""
+    return check_int(seed, "seed", 0, MAX_DATA_SEED)
 
 
 def check_workers(workers: object) -> int | None:

@@ -67,7 +67,7 @@ def generate(
     """
     if env not in ENVS:
         raise UnknownNameError(f"env: unknown environment {env!r}; choose one of {list(ENVS)}")
-    check_split(n, near, workers)
+    check_split(n, near, workers, seed)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     size = sampling.SHARD_SIZE

@@ -77,7 +77,7 @@ def generate3d(
     """
     if env not in ENVS3D:
         raise InputError(f"env: unknown 3-D environment {env!r}; choose one of {list(ENVS3D)}")
-    check_split(n, near, workers)
+    check_split(n, near, workers, seed)
     if shard_size < 1 or shard_size % SCENE_SAMPLES:
         raise InputError(f"shard_size: expected a positive multiple of {SCENE_SAMPLES}")
     out_dir = Path(out_dir)
