@@ -89,6 +89,8 @@ def test_point_files_npy_and_text(tmp_path):
     (tmp_path / "c.xyz").write_text("# x y z\n0.5 0 0.2\n0.5, 0.1, 0.2\n0.51 -0.1 0.35 # last\n")
     assert np.array_equal(read_cloud(tmp_path / "c.npy"), pts)
     assert np.array_equal(read_cloud(tmp_path / "c.xyz"), pts)
+    (tmp_path / "bom.xyz").write_text("\ufeff0.5 0 0.2\n0.5 0.1 0.2\n0.51 -0.1 0.35\n")
+    assert np.array_equal(read_cloud(tmp_path / "bom.xyz"), pts)  # a UTF-8 byte-order mark
     (tmp_path / "bad.xyz").write_text("0.5 0 oops\n")
     (tmp_path / "two.xyz").write_text("0.5 0\n0.1 0.2\n")
     (tmp_path / "bin.npy").write_bytes(b"\x93NUMPY garbage")

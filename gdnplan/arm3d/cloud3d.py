@@ -97,7 +97,7 @@ def read_cloud(path: Path | str, name: str = "cloud") -> np.ndarray:
         if path.suffix.lower() == ".npy":
             pts = np.load(io.BytesIO(data), allow_pickle=False)
         else:
-            text = data.decode("utf-8").replace(",", " ")
+            text = data.decode("utf-8-sig").replace(",", " ")  # a BOM some editors write
             with warnings.catch_warnings():  # no data: refused below, with the shape
                 warnings.simplefilter("ignore", UserWarning)
                 pts = np.loadtxt(text.splitlines(), dtype=float, comments="#", ndmin=2)
