@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import gdnplan as gp
@@ -467,6 +467,81 @@ def test_a_locked_mimic_follower_follows_its_master(tmp_path, kind, j1):
         assert np.allclose(shape_placements_batch(follows, q), shape_placements_batch(explicit, q))
     with pytest.raises(InputError, match="'j2' mimics 'j1'"):
         build({"j1": j1, "j2": 2 * j1 + 0.2})
+
+
+def mimic_tree(folder: Path, masters, kinds, order, mimic: bool = True) -> Path:
+    """j1 (planned, about z) → m0 → m1 → … a chain of locked joints about y (link k_i after
+    m_i); m_i (i ≥ 1)
+    mimics m_{masters[i-1]} (2 m + 0.1, an earlier joint), ``kinds`` revolute or continuous;
+    the joints are written in the permutation ``order`` of the chain."""
+    limit = '<limit lower="-100" upper="100" effort="1" velocity="1"/>'
+    parts = ['<link name="base"/>', joint("j1", "base", "l1"), link("l1")]
+    chain = []
+    for i, kind in enumerate(["revolute", *kinds]):
+        parent = "l1" if i == 0 else f"k{i - 1}"
+        tag = joint(f"m{i}", parent, f"k{i}", kind=kind, xyz="0.4 0 0", axis="0 1 0")
+        tag = tag.replace(LIMIT, limit)
+        if i and mimic:
+            tag = tag.replace(
+                "</joint>",
+                f'<mimic joint="m{masters[i - 1]}" multiplier="2" offset="0.1"/></joint>',
+            )
+        chain.append(tag)
+        parts.append(link(f"k{i}", length=0.3))
+    name = "mimic_tree" if mimic else "plain_tree"
+    return write_urdf(folder, *parts, *(chain[k] for k in order), name=name)
+
+
+@st.composite
+def mimic_trees(draw):
+    n = draw(st.integers(1, 4))
+    masters = [draw(st.integers(0, i)) for i in range(n)]
+    kinds = draw(st.lists(st.sampled_from(["revolute", "continuous"]), min_size=n, max_size=n))
+    order = draw(st.permutations(range(n + 1)))
+    return masters, kinds, order, draw(st.floats(-1.0, 1.0))
+
+
+@settings(max_examples=40, deadline=None)
+@given(mimic_trees())
+@example(([0, 1], ["revolute", "continuous"], [2, 1, 0], 0.5))  # the audit's chain, reversed
+@example(([0], ["continuous"], [0, 1], 1.0))  # a continuous follower stayed at 0
+def test_locked_mimic_chains_follow_their_masters_in_any_file_order(tree):
+    """Every locked <mimic> follower sits at 2 · master + 0.1, its master's final value, also
+    when the master is itself a follower written later in the file, and for continuous joints
+    (a follower of a follower, or a continuous follower, used to stay at 0: the arm certified
+    was not the URDF's)."""
+    from gdnplan.arm3d import robot3d_from_urdf
+    from gdnplan.arm3d.fk3d import shape_placements_batch
+
+    masters, kinds, order, m0 = tree
+    values = [m0]
+    for master in masters:
+        values.append(2 * values[master] + 0.1)
+    with tempfile.TemporaryDirectory() as folder:
+        follows = robot3d_from_urdf(
+            mimic_tree(Path(folder), masters, kinds, order), joints=["j1"], locked={"m0": m0}
+        )
+        locked = {f"m{i}": v for i, v in enumerate(values)}
+        plain = mimic_tree(Path(folder), masters, kinds, order, mimic=False)
+        explicit = robot3d_from_urdf(plain, joints=["j1"], locked=locked)
+    q = np.array([[0.7]])
+    assert np.allclose(shape_placements_batch(follows, q), shape_placements_batch(explicit, q))
+
+
+@pytest.mark.parametrize(
+    "mimic, match",
+    [('<mimic joint="nope"/>', "names 'nope', not a joint"), ('<mimic joint="m1"/>', "cycle")],
+)
+def test_a_mimic_of_no_joint_or_a_mimic_cycle_is_refused(tmp_path, mimic, match):
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    path = mimic_tree(tmp_path, [0], ["revolute"], [0, 1])  # m1 mimics m0
+    text = path.read_text()
+    m0 = text.index('<joint name="m0"')
+    end = text.index("</joint>", m0)
+    path.write_text(text[:end] + mimic + text[end:])
+    with pytest.raises(InputError, match=match):
+        robot3d_from_urdf(path, joints=["j1"])
 
 
 def _dense_surface(kind: str, r: float, length: float, n: int = 400) -> np.ndarray:
