@@ -213,3 +213,18 @@ def test_locked_joints_never_hide_a_self_collision(wrist, seed):
     moving = [body[a.split("/")[0]] != body[b.split("/")[0]] for a, b in table.pair_names()]
     d_pairs, _ = table.pair_distances(np.c_[q, np.tile(wrist, (len(q), 1))])
     assert np.allclose(d, d_pairs[:, moving].min(axis=1), atol=1e-9)
+
+
+def test_a_robot3d_is_immutable_once_built():
+    """Motion bounds and checkers are cached per robot object and load_robot3d hands every
+    caller the same one: neither attributes nor arrays can change under them."""
+    from gdnplan.arm3d import load_robot3d
+
+    robot = load_robot3d("ur5e")
+    for name in ("shapes", "model", "lower", "self_pairs", "contact_only", "new_attribute"):
+        with pytest.raises(AttributeError, match="immutable"):
+            setattr(robot, name, None)
+    for array in (robot.lower, robot.upper, robot.self_pairs, robot.shape_link):
+        with pytest.raises(ValueError, match="read-only"):
+            array[0] = array[0]
+    assert load_robot3d("ur5e") is robot and robot.lower.flags.writeable is False

@@ -59,7 +59,8 @@ class LinkShape:
 
 
 class Robot3D:
-    """A 3-D arm: a reduced Pinocchio model, coal link shapes and self-collision pairs.
+    """A 3-D arm: a reduced Pinocchio model, coal link shapes and self-collision pairs;
+    immutable once built (its arrays are read-only, its attributes cannot be set).
 
     Attributes:
         name: the robot's name. model: the reduced ``pin.Model`` (nq = nv = dof).
@@ -98,6 +99,19 @@ class Robot3D:
         self.upper = model.upperPositionLimit.copy()
         self.info = dict(info or {})
         self.joint_names = tuple(model.names[1:])
+        for array in (self.shape_link, self.shape_body, self.self_pairs, self.lower, self.upper):
+            array.flags.writeable = False
+        self.self_contact_only.flags.writeable = False
+        object.__setattr__(self, "_frozen", True)
+
+    def __setattr__(self, name: str, value) -> None:
+        """Immutable once built: the certificate's motion bounds and the checkers are cached
+        per robot object (and ``load_robot3d`` hands every caller the same one)."""
+        if getattr(self, "_frozen", False):
+            raise AttributeError(
+                f"Robot3D is immutable: build a new robot instead of setting {name!r}"
+            )
+        object.__setattr__(self, name, value)
 
     @property
     def dof(self) -> int:
