@@ -544,6 +544,32 @@ def test_a_mimic_of_no_joint_or_a_mimic_cycle_is_refused(tmp_path, mimic, match)
         robot3d_from_urdf(path, joints=["j1"])
 
 
+@settings(max_examples=20, deadline=None)
+@given(
+    st.sampled_from(["j1", "j2"]),
+    st.sampled_from(["base", "l1", "l2"]),
+    st.sampled_from(["revolute", "fixed"]),
+    st.sampled_from(["planar", "3d"]),
+)
+@example("j1", "l1", "revolute", "3d")  # the audit's case: exit 3, ValueError from Pinocchio
+def test_a_joint_named_as_a_link_is_refused(joint_name, link_name, kind2, loader):
+    """URDF allows a joint and a link of one name; Pinocchio's reduced model then raised a
+    ValueError ("Several frames match the filter"): both loaders refuse it by name."""
+    from gdnplan.arm3d import robot3d_from_urdf
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = two_link(Path(folder), kind2=kind2)
+        text = path.read_text().replace(f'joint name="{joint_name}"', f'joint name="{link_name}"')
+        path.write_text(text)
+        planning = tuple(j if j != joint_name else link_name for j in ("j1", "j2"))
+        planning = planning if kind2 == "revolute" else planning[:1]
+        with pytest.raises(InputError, match=f"joint '{link_name}' and link '{link_name}'"):
+            if loader == "planar":
+                robot_from_urdf("clash", RobotSpec(urdf=path, planning_joints=planning))
+            else:
+                robot3d_from_urdf(path, joints=list(planning))
+
+
 def _dense_surface(kind: str, r: float, length: float, n: int = 400) -> np.ndarray:
     """Dense points on a sphere, cylinder or capsule surface (its frame, axis z), (k, 3)."""
     rng = np.random.default_rng(0)

@@ -22,7 +22,7 @@ from .joint_limits import check_joint_limits, make_continuous_revolute, unlimit_
 from .meshes import check_meshes
 from .spec import RobotSpec
 from .stderr import stderr_captured
-from .xml_checks import MAX_OFFSET, check_urdf_xml, collision_counts
+from .xml_checks import MAX_OFFSET, check_frame_names, check_urdf_xml, collision_counts
 
 AXIS_UNIT_TOLERANCE = 1e-9  # largest | |axis| − 1 | of a joint axis after Pinocchio's parse
 __all__ = ["MAX_OFFSET", "check_mimic", "load_urdf", "stderr_captured"]
@@ -53,6 +53,7 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
         raise InputError(f"urdf: {path} is not a readable XML file ({reason})") from e
     _check_mimic(root, spec.planning_joints, path)
     check_urdf_xml(root, path)
+    check_frame_names(root, path)
     packages = [str(p) for p in spec.package_dirs] + [str(p) for p in path.resolve().parents]
     check_meshes(root, path, packages)
     bare = make_continuous_revolute(root, spec.planning_joints)

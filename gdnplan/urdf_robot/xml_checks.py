@@ -74,6 +74,19 @@ def check_urdf_xml(root: ET.Element, path: Path) -> None:
             _check_geometry(collision, where)
 
 
+def check_frame_names(root: ET.Element, path: Path) -> None:
+    """InputError when a joint and a link share a name: URDF keeps them apart, Pinocchio makes
+    a frame of each and then cannot tell them apart (its reduced model raised a ValueError)."""
+    links = {link.get("name") for link in root.findall("link")}
+    for joint in root.findall("joint"):
+        if joint.get("name") in links:
+            name = shown(joint.get("name"))
+            raise InputError(
+                f"urdf: {path.name}: joint {name} and link {name} share a name, which "
+                "Pinocchio cannot tell apart; rename one of them"
+            )
+
+
 def collision_counts(root: ET.Element) -> dict[str, int]:
     """{link name: number of its ``<collision>`` elements} (urdfdom reads the direct children
     of ``<robot>`` and of each ``<link>``)."""
