@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import minimize
 from scipy.spatial import ConvexHull
@@ -18,6 +18,7 @@ from gdnplan.arm3d import (
     box_obstacle,
     load_robot3d,
     random_boxes,
+    signed_distance3d,
     signed_distance3d_and_grad,
 )
 from gdnplan.errors import InputError
@@ -129,3 +130,24 @@ def test_coal3d_model_is_a_distance_model(ur5e_scene):
     d2, g2 = signed_distance3d_and_grad(ur5e_scene, q, per_link=True)
     assert d2.shape == (4, ur5e_scene.robot.n_links) and g2.shape == (4, d2.shape[1], 6)
     np.testing.assert_allclose(d2.min(1), d)
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 3), st.booleans(), st.booleans())
+@example(0, False, False)  # the audit's case: IndexError on an empty batch
+def test_a_batch_of_any_size_has_the_shapes_of_its_rows(batch, per_link, gradient):
+    """(B,) or (B, L) distances and (…, dof) gradients for every B, 0 included (an empty
+    batch raised IndexError; the planar functions return empty arrays), each row equal to its
+    configuration alone."""
+    robot = load_robot3d("ur5e")
+    scene = Scene3D(robot, [box_obstacle((0.1, 0.1, 0.1), (0.5, 0.0, 0.3))])
+    q = robot.random_configurations(batch, np.random.default_rng(batch))
+    tail = (robot.n_links,) if per_link else ()
+    if gradient:
+        d, g = signed_distance3d_and_grad(scene, q, per_link=per_link)
+        assert g.shape == (batch, *tail, robot.dof)
+    else:
+        d = signed_distance3d(scene, q, per_link=per_link)
+    assert d.shape == (batch, *tail)
+    for i in range(batch):
+        assert np.array_equal(d[i], signed_distance3d(scene, q[i], per_link=per_link)[0])

@@ -163,13 +163,18 @@ class Checker3D(PairTable):
             self.scan(qi, per_link, cap, broad_phase, (tf[i], bounds[i]), offsets)
             for i, qi in enumerate(q)
         ]
-        dist = np.array([r[0] for r in rows])
-        pair = np.array([r[1] for r in rows])
-        p1, p2, nrm = (np.array([r[i] for r in rows]) for i in (2, 3, 4))
+        n = (len(q), self.robot.n_links if per_link else 1)  # (B, T), B = 0 included
+
+        def stacked(i: int, tail: tuple = (), dtype=float) -> np.ndarray:
+            return np.array([r[i] for r in rows], dtype).reshape(*n, *tail)
+
+        dist, pair = stacked(0), stacked(1, dtype=int)
+        p1, p2, nrm = (stacked(i, (3,)) for i in (2, 3, 4))
         narrow = np.array([r[5] for r in rows], dtype=int)
         grad = None
         if gradient:
-            grad = np.array([self.gradient(qi, *r[1:5]) for qi, r in zip(q, rows, strict=True)])
+            grads = [self.gradient(qi, *r[1:5]) for qi, r in zip(q, rows, strict=True)]
+            grad = np.array(grads, float).reshape(*n, self.robot.dof)
         squeeze = (lambda a: a[:, 0]) if not per_link else (lambda a: a)
         return Distances3D(
             squeeze(dist),
