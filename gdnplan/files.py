@@ -89,10 +89,18 @@ def check_output_dir(path: Path | str, what: str = "output") -> Path:
 
     Raises:
         OutputError: ``path`` exists and is not a directory (or is a symlink to something else),
-            an ancestor is not a directory, or the directory that would hold it is read-only.
+            an ancestor is not a directory, the directory that would hold it is read-only, or
+            the system refuses the name (a component longer than the file system allows).
     """
     path = Path(path)
-    if os.path.lexists(path):
+    try:
+        exists = os.lstat(path) is not None
+    except (FileNotFoundError, NotADirectoryError):  # the ancestors are checked below
+        exists = False
+    except (OSError, ValueError) as e:  # a name too long, a NUL byte
+        why = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
+        raise OutputError(f"{what}: cannot write {path} ({why})") from e
+    if exists:
         if not path.is_dir():
             raise OutputError(f"{what}: {path} exists and is not a directory")
         _probe_writable(path, path, what)

@@ -11,6 +11,8 @@ import sys
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from gdnplan.errors import GdnplanError, OutputError
 from gdnplan.files import atomic_path, check_output_dir, check_output_path, write_text
@@ -170,6 +172,30 @@ def test_check_output_dir(tmp_path):
         check_output_dir(file / "sub")
     assert check_output_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b"
     assert issubclass(OutputError, GdnplanError)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(1, 400), st.booleans(), st.sampled_from(["dir", "file"]))
+@example(300, False, "dir")  # the audit's case: fetch --3d --write-problems exited 3 (OSError)
+@example(300, True, "dir")
+def test_a_name_the_system_refuses_is_an_output_error(tmp_path_factory, length, nested, kind):
+    """A path component longer than the file system allows (255 bytes here) is one
+    OutputError naming the path, for a directory as for a file; shorter ones are accepted."""
+    base = tmp_path_factory.mktemp("names")
+    path = base / ("x" * length)
+    path = path / "sub" if nested else path
+    path = path.with_suffix(".png") if kind == "file" else path
+    check = check_output_dir if kind == "dir" else lambda p: check_output_path(p, (".png",))
+    if any(len(os.fsencode(part)) > 255 for part in path.relative_to(base).parts):
+        with pytest.raises(OutputError, match="cannot write"):
+            check(path)
+    else:
+        assert check(path) == path
+
+
+def test_a_nul_byte_in_an_output_directory_is_an_output_error(tmp_path):
+    with pytest.raises(OutputError, match="cannot write"):
+        check_output_dir(tmp_path / "a\0b")
 
 
 # ------------------------------------------------------- the CLI checks outputs before the work
