@@ -18,7 +18,9 @@ scene. Every shipped scene keeps H = 1 m (its prisms as before); obstacles up to
 :func:`gdnplan.scene.coordinate_bound` make H a few hundred metres. Apart
 shapes do not depend on H (GJK, unchanged values); overlapping ones go to EPA, whose tolerance
 ``EPA_TOLERANCE`` is tight enough that tall prisms keep the depth exact to ~1e-15 (coal's
-default 1e-6 lost 1e-3 relative at H = 3 km, tests/test_distance_depth.py).
+default 1e-6 lost 1e-3 relative at H = 3 km, tests/test_distance_depth.py). Where EPA fails at
+that tolerance (it returns −DBL_MAX), the pair is recomputed with coal's default request, and
+if that fails too its bounding circles' lower bound is used (:meth:`CoalChecker._pair`).
 
 For the winning pair coal returns witness points p₁ (on the link) and p₂ (on the obstacle)
 and the unit normal n from shape 1 to shape 2 with d = n · (p₂ − p₁). As only p₁ moves,
@@ -31,6 +33,8 @@ lower bound |c_k − c_p| − r_k − r_p cannot beat the best distance found so
 
 from __future__ import annotations
 
+import logging
+import math
 import os
 import weakref
 from concurrent.futures import ProcessPoolExecutor
@@ -47,6 +51,8 @@ MIN_PRISM_HALF_HEIGHT = 1.0  # m: the prisms' half-height in small scenes (all s
 PRISM_SAFETY = 1.0  # half-height / (largest link radius + largest part radius)
 EPA_TOLERANCE = 1e-9  # coal's EPA stopping tolerance (its default 1e-6 is too loose, above)
 PARALLEL_MIN_BATCH = 2000  # batches at least this large are split over all cores
+
+log = logging.getLogger(__name__)
 
 
 def prism_half_height(scene: Scene) -> float:
@@ -104,6 +110,8 @@ class CoalChecker:
         self.request = coal.DistanceRequest()
         self.request.enable_signed_distance = True
         self.request.epa_tolerance = EPA_TOLERANCE
+        self.fallback = coal.DistanceRequest()  # coal's defaults: retried when EPA fails
+        self.fallback.enable_signed_distance = True
         self.result = coal.DistanceResult()
         self.functors = [
             [coal.ComputeDistance(ls, ps) for ps in self.part_shapes] for ls in self.link_shapes
@@ -123,10 +131,32 @@ class CoalChecker:
     def _pair(
         self, link: int, part: int, tf: coal.Transform3s
     ) -> tuple[float, np.ndarray, np.ndarray]:
+        """Signed distance (m), witness point on the link (2,) and unit normal (2,) of a pair.
+
+        coal's EPA sometimes fails at ``EPA_TOLERANCE`` (it returns −DBL_MAX): a distance below
+        −(r_link + r_part), deeper than the bounding circles allow, is recomputed with coal's
+        default request, and if that fails too the bounding circles' bound is used."""
         res = self.result
-        res.clear()
-        self.functors[link][part](tf, self.identity, self.request, res)
-        return res.min_distance, res.getNearestPoint1()[:2].copy(), res.normal[:2].copy()
+        deepest = -(self.link_radius[link] + self.part_radius[part])
+        for request in (self.request, self.fallback):
+            res.clear()
+            self.functors[link][part](tf, self.identity, request, res)
+            d = res.min_distance
+            if math.isfinite(d) and d >= deepest:
+                return d, res.getNearestPoint1()[:2].copy(), res.normal[:2].copy()
+        return self._circle_bound(link, part, tf)
+
+    def _circle_bound(
+        self, link: int, part: int, tf: coal.Transform3s
+    ) -> tuple[float, np.ndarray, np.ndarray]:
+        """The bounding circles' lower bound |c_l − c_p| − r_l − r_p of a pair (coal failed
+        twice), its witness on the link's circle and the normal along the centres."""
+        log.warning("coal failed on link %d and obstacle part %d; using their circles", link, part)
+        center = tf.transform(np.r_[self.link_center0[link], 0.0])[:2]
+        gap = self.part_center[part] - center
+        n = gap / max(float(np.linalg.norm(gap)), 1e-12)
+        d = float(np.linalg.norm(gap)) - self.link_radius[link] - self.part_radius[part]
+        return d, center + self.link_radius[link] * n, n
 
     def _transforms(self, pose: np.ndarray) -> list[coal.Transform3s]:
         """Coal placements of every link polygon for one configuration's body poses (dof+1, 3)."""

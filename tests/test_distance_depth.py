@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import Polygon
 
@@ -147,3 +147,22 @@ def test_small_depths_stay_exact_under_the_tallest_prisms():
     assert len(deep) > 20
     want = np.array([truth(base, q[i]) for i in deep])
     np.testing.assert_allclose(got[deep], want, rtol=0, atol=1e-9)
+
+
+EPA_FAILURE_Q = (-1.416696206270574, 1.7541657033869262, 0.01599084383486954)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.lists(st.floats(-0.02, 0.02), min_size=3, max_size=3))
+@example([0.0, 0.0, 0.0])  # coal's EPA returned −DBL_MAX here (fetch seed 10²⁰ − 1, holding)
+def test_distances_near_an_epa_failure_match_the_separating_axes(offset):
+    """Where coal's EPA fails at the tight tolerance (−DBL_MAX for a finger overlapping the
+    storage by 3.3 mm: signed_distance returned −1.8e308), the pair is recomputed with coal's
+    default request: every distance nearby matches the independent SAT/shapely truth."""
+    from gdnplan.fetch import fetch_scenes
+
+    scene = fetch_scenes(10**20 - 1)["holding"]
+    q = np.asarray(EPA_FAILURE_Q) + np.asarray(offset)
+    d = gp.signed_distance(scene, q[None])[0]
+    assert np.isfinite(d)
+    assert d == pytest.approx(truth(scene, q), abs=1e-6)
