@@ -7,7 +7,7 @@ import logging
 import coal
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
@@ -207,3 +207,68 @@ def test_a_mesh_scale_of_non_numbers_is_refused(tmp_path, scale):
     write_stl(path, CUBE, [(0, 1, 2), (4, 5, 6), (0, 4, 5), (1, 3, 7)])
     with pytest.raises(InputError, match=r"m\.scale: expected three positive numbers"):
         load_mesh(path, scale, name="m")
+
+
+SIZES = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True, width=64),
+    st.sampled_from([0.0, -0.5, 1e-7, 1e-6, 0.3, 1e3, 1e4]),
+)
+RAW_SHAPES = {
+    "box": lambda s: coal.Box(s, 0.2, 0.2),
+    "sphere": lambda s: coal.Sphere(s),
+    "cylinder": lambda s: coal.Cylinder(0.1, s),
+    "capsule": lambda s: coal.Capsule(s, 0.3),
+}
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(sorted(RAW_SHAPES)), SIZES, st.sampled_from(["obstacle", "held"]))
+@example("box", float("nan"), "obstacle")  # the audit's cases: never hit by any distance
+@example("sphere", -0.5, "held")
+def test_a_raw_coal_shape_is_checked_as_the_builders_check_it(kind, size, where):
+    """obstacle(shape, …) and hold(robot, shape, …) take coal shapes: one out of the builders'
+    ranges (NaN, negative, zero, beyond 1000 m) is an InputError, as box(), sphere(), …
+    refuse it (a raw coal.Box(nan, …) in the scene was silently never hit)."""
+    from gdnplan.arm3d import load_robot3d, obstacle
+    from gdnplan.arm3d.held import hold
+
+    sides = size * (2 if kind == "box" else 1)  # coal.Box takes full sides
+    valid = bool(np.isfinite(sides)) and 1e-6 <= sides <= 1e3
+    shape = RAW_SHAPES[kind](size)
+    build = (
+        (lambda: obstacle(shape, (0.5, 0.0, 0.3)))
+        if where == "obstacle"
+        else (lambda: hold(load_robot3d("ur5e"), shape))
+    )
+    if valid:
+        build()
+    else:
+        with pytest.raises(InputError):
+            build()
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3),
+    st.floats(0.0, 3.0),
+)
+@example([50.0, 0.0, 0.0], 0.01)  # the audit's: a box hidden from the broad phase
+def test_an_obstacle_sphere_must_enclose_its_shape(center, radius):
+    """An Obstacle3D built by hand keeps its (center, radius) only when that sphere encloses
+    the shape's: the broad phase skips pairs by it, and a wrong one hid the obstacle (a 0.6 m
+    box through the arm read +0.0145 m instead of −0.119 m)."""
+    from gdnplan.arm3d import Scene3D, load_robot3d, signed_distance3d
+    from gdnplan.arm3d.scene3d import Obstacle3D
+
+    good = box_obstacle((0.6, 0.6, 0.6), (0.4, 0.0, 0.3))
+    center = np.asarray(center)
+    encloses = np.linalg.norm(center - good.center) + good.radius <= radius
+    if not encloses:
+        with pytest.raises(InputError, match="do not enclose"):
+            Obstacle3D("hand", good.shape, good.pose, center, radius)
+        return
+    robot = load_robot3d("ur5e")
+    q = np.array([0.0, -1.2, 1.2, -1.5, -1.57, 0.0])
+    hand = Obstacle3D("hand", good.shape, good.pose, center, radius)
+    d = signed_distance3d(Scene3D(robot, [hand]), q)
+    assert d == pytest.approx(signed_distance3d(Scene3D(robot, [good]), q), abs=1e-9)

@@ -25,7 +25,7 @@ from ..errors import InputError
 from ..ur5e.gripper import FINGER_LENGTH, GRASP_GAP
 from .ik3d import tool_frame
 from .robot3d import LinkShape, Robot3D
-from .shapes import as_pose, bounding_sphere, box
+from .shapes import as_pose, bounding_sphere, box, check_shape
 
 HELD_LINK = "held_object"  # the link name of the held object's shape
 
@@ -68,7 +68,7 @@ def hold(
     as_pose(tf[:3, 3], tf[:3, :3], "placement")  # validates the rotation
     fr = model.frames[model.getFrameId(frame)]
     body = int(fr.parentJoint)
-    center, radius = bounding_sphere(shape)
+    center, radius = bounding_sphere(check_shape(shape, "held"))
     held = LinkShape(name, HELD_LINK, body, shape, fr.placement.homogeneous @ tf, center, radius)
     shapes = (*robot.shapes, held)
     k = len(shapes) - 1

@@ -20,10 +20,21 @@ import coal
 import numpy as np
 
 from ..errors import InputError
-from ..limits import check_int, check_number
+from ..limits import check_int, check_number, is_number
 from ..robot import Robot, check_seed
 from .robot3d import Robot3D
-from .shapes import as_pose, bounding_sphere, box, capsule, convex, cylinder, load_mesh, sphere
+from .shapes import (
+    as_pose,
+    as_vector,
+    bounding_sphere,
+    box,
+    capsule,
+    check_shape,
+    convex,
+    cylinder,
+    load_mesh,
+    sphere,
+)
 
 MAX_OBSTACLES = 10_000
 BOX_SIZE = (0.05, 0.2)  # m: random_boxes' default (smallest, largest) side
@@ -49,14 +60,42 @@ class Obstacle3D:
     radius: float
     points: np.ndarray | None = field(default=None, repr=False)
 
+    def __post_init__(self) -> None:
+        """InputError unless the obstacle is one :func:`obstacle` could build: a string name,
+        a valid shape (:func:`~gdnplan.arm3d.shapes.check_shape`), a rigid pose, and a sphere
+        (center, radius) enclosing the shape: the broad phase skips pairs by it, so a
+        hand-built obstacle with a wrong one was never hit."""
+        if not isinstance(self.name, str):
+            raise InputError(f"name: expected a string, got {self.name!r}")
+        check_shape(self.shape, self.name, octree=True)
+        if not isinstance(self.pose, coal.Transform3s):
+            raise InputError(f"{self.name}.pose: expected a coal.Transform3s, got {self.pose!r}")
+        as_pose(self.pose.getTranslation(), self.pose.getRotation(), f"{self.name}.pose")
+        center, radius = world_sphere(self.shape, self.pose)
+        given = as_vector(self.center, 3, f"{self.name}.center")
+        if not is_number(self.radius) or not (
+            np.linalg.norm(given - center) + radius <= self.radius + 1e-9 * (1 + radius)
+        ):
+            raise InputError(
+                f"{self.name}: center {given.tolist()} and radius {self.radius!r} m do not "
+                f"enclose its shape (its bounding sphere: centre {center.round(6).tolist()}, "
+                f"radius {radius:.6g} m); build obstacles with gdnplan.arm3d.obstacle"
+            )
+
+
+def world_sphere(shape, pose: coal.Transform3s) -> tuple[np.ndarray, float]:
+    """World centre (3,) and radius (m) of the bounding sphere of ``shape`` posed at ``pose``."""
+    local_center, radius = bounding_sphere(shape)
+    center = np.asarray(pose.getRotation()) @ local_center + np.asarray(pose.getTranslation())
+    return center, radius
+
 
 def obstacle(shape, position=(0.0, 0.0, 0.0), rotation=None, name: str = "obstacle"):
     """An :class:`Obstacle3D` of a coal shape (built by :mod:`gdnplan.arm3d.shapes`) posed in
     the world: ``position`` (3,) in m, ``rotation`` a quaternion (x, y, z, w) or a 3×3 matrix."""
     pose = as_pose(position, rotation, name)
-    local_center, radius = bounding_sphere(shape)
-    center = np.asarray(pose.getRotation()) @ local_center + np.asarray(pose.getTranslation())
-    return Obstacle3D(name, shape, pose, center, radius)
+    check_shape(shape, name if isinstance(name, str) else "obstacle", octree=True)
+    return Obstacle3D(name, shape, pose, *world_sphere(shape, pose))
 
 
 def box_obstacle(size, position, rotation=None, name: str = "box") -> Obstacle3D:

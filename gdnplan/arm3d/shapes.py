@@ -166,6 +166,29 @@ def convex(points, name: str = "convex") -> coal.ConvexBase:
     return _coal_hull(vertices)
 
 
+def check_shape(shape, name: str, octree: bool = False):
+    """``shape`` when it is a coal shape the builders of this module could have made: sizes in
+    [``MIN_SIZE``, ``MAX_COORDINATE``] m, a convex hull's points checked as :func:`convex`'s, an
+    ``OcTree`` (a point cloud) only with ``octree``. InputError naming ``name`` otherwise: a
+    raw ``coal.Box(nan, 1, 1)`` or ``coal.Sphere(-1)`` was never hit by any distance."""
+    if isinstance(shape, coal.Box):
+        box(2 * np.asarray(shape.halfSide), name)
+    elif isinstance(shape, coal.Sphere):
+        sphere(shape.radius, name)
+    elif isinstance(shape, (coal.Capsule, coal.Cylinder)):
+        as_size(shape.radius, f"{name}.radius")
+        as_size(2 * shape.halfLength, f"{name}.length")
+    elif isinstance(shape, coal.ConvexBase):
+        hull_vertices(np.array([shape.point(i) for i in range(shape.num_points)]), name)
+    elif not (octree and isinstance(shape, coal.OcTree)):
+        kinds = "Box, Sphere, Cylinder, Capsule or ConvexBase" + (" or OcTree" if octree else "")
+        raise InputError(
+            f"{name}: expected a coal {kinds} (build it with gdnplan.arm3d.shapes), got "
+            f"{type(shape).__name__}"
+        )
+    return shape
+
+
 def _coal_hull(vertices: np.ndarray) -> coal.ConvexBase:
     cloud = coal.StdVec_Vec3s()
     for p in vertices:
@@ -298,6 +321,7 @@ __all__ = [
     "bounding_sphere",
     "box",
     "capsule",
+    "check_shape",
     "convex",
     "cylinder",
     "is_convex_mesh",
