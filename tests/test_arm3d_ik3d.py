@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from gdnplan.arm3d import Scene3D, box_obstacle, checker3d, load_robot3d
@@ -179,3 +179,25 @@ def test_cartesian_path_takes_one_point_or_several():
     )  # fmt: skip
     assert one.shape == (2, 6) and two.shape == (3, 6)
     assert np.linalg.norm(frame_pose(robot, two[-1]).translation - up) < 1e-4
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    st.one_of(
+        st.integers(-(2**70), -1),
+        st.floats(allow_nan=True),
+        st.booleans(),
+        st.text(max_size=3),
+    )
+)
+@example(-1)  # the audit's case: numpy's ValueError, exit 3 from a problem file's caller
+def test_a_bad_ik_seed_is_an_input_error_naming_it(seed):
+    """solve_pose_ik and collision_fraction check their seed as every other seed is checked
+    (a negative one raised numpy's ValueError, a float numpy's TypeError)."""
+    from gdnplan.arm3d.problem3d import collision_fraction
+
+    scene = Scene3D(load_robot3d("ur5e"))
+    with pytest.raises(InputError, match="seed: expected"):
+        solve_pose_ik(scene, (0.4, 0.0, 0.5), seed=seed)
+    with pytest.raises(InputError, match="seed: expected"):
+        collision_fraction(scene, n=2, seed=seed)

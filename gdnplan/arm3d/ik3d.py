@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import InfeasibleProblemError, InputError
 from ..limits import check_number
+from ..robot_checks import make_rng
 from .distance3d import checker3d
 from .ik3d_checks import MAX_POINTS, MIN_TOL, check_ik_settings, check_positions
 from .robot3d import Robot3D
@@ -186,7 +187,7 @@ def solve_pose_ik(
     check_ik_settings(margin, restarts, solutions, iterations, position_tol, rotation_tol)
     mid = (robot.lower + robot.upper) / 2
     ref = mid if reference is None else robot.check_q(reference, "reference")[0]
-    rng = np.random.default_rng(seed)
+    rng = make_rng(seed)
     checker = checker3d(scene)
     found: list[tuple[np.ndarray, float]] = []
     converged = 0

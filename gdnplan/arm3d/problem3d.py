@@ -29,6 +29,7 @@ import numpy as np
 from ..ccd import proven_distance
 from ..errors import InputError
 from ..limits import check_int, check_number
+from ..robot_checks import make_rng
 from ..trajopt.problem import Problem
 from .builtin import load_robot3d
 from .distance3d import checker3d, signed_distance3d
@@ -51,7 +52,7 @@ def reaching_scene(robot: Robot3D | str, seed: int, boxes: int = 20) -> Scene3D:
 def collision_fraction(scene: Scene3D, n: int = 500, seed: int = 0) -> float:
     """Share of ``n`` uniformly random configurations in collision (signed distance ≤ 0)."""
     robot = scene.robot
-    q = robot.random_configurations(check_int(n, "n", 1, 10**6), np.random.default_rng(seed))
+    q = robot.random_configurations(check_int(n, "n", 1, 10**6), make_rng(seed))
     return float(np.mean(signed_distance3d(scene, q) <= 0))
 
 
