@@ -27,6 +27,11 @@ BAD = [
     ["fetch", "--3d", "--collision", "graphdistnet", "--weights", "ur5e_boxes3d_preliminary"],
     ["fetch", "--3d", "--weights", "ur5e_boxes3d_preliminary"],  # weights without graphdistnet
     ["fetch", "--3d", "--write-problems", "{tmp}/a_file"],
+    ["fetch", "--3d", "--view3d"],
+    ["fetch", "--3d", "--write-problems", ""],  # wrote into the working directory
+    ["fetch", "--3d", "--write-problems", "{tmp}/" + "x" * 300],  # exit 3: ENAMETOOLONG
+    ["fetch", "--3d", "--collision", ""],  # was silently coal
+    ["fetch", "--collision", ""],  # was silently graphdistnet
 ]
 
 

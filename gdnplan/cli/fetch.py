@@ -38,7 +38,7 @@ def fetch_command(
     placement: str = typer.Option(
         None, help="--3d: the storage's front-face centre and yaw 'x,y,yaw' (m, m, rad)."
     ),
-    write_problems: Path = typer.Option(
+    write_problems: str = typer.Option(
         None, help="--3d: write each planned stage's problem files into this directory."
     ),
 ) -> None:
@@ -50,24 +50,16 @@ def fetch_command(
     from ..fetch import run_fetch
 
     show_progress(not quiet)
+    if write_problems == "":
+        raise InputError("--write-problems: expected a directory, got an empty string")
     if three_d:
-        planar_only = {"--animate": animate, "--view3d": view3d}
-        if collision not in (None, "coal", "graphdistnet"):
-            planar_only["--collision"] = collision
-        if weights is not None and collision != "graphdistnet":
-            planar_only["--weights"] = weights
-        for flag, value in planar_only.items():
-            if value:
-                raise InputError(
-                    f"{flag}: the 3-D fetch does not take it (coal, or --collision graphdistnet "
-                    "--weights W trained on ur5e_storage)"
-                )
+        _check_3d_options(animate, view3d, collision, weights)
         from .fetch3d import run_fetch3d_command
 
         set_threads(threads)
-        if not run_fetch3d_command(
-            seed, placement, json_output, write_problems, collision or "coal", weights
-        ):
+        out = None if write_problems is None else Path(write_problems)
+        model = "coal" if collision is None else collision
+        if not run_fetch3d_command(seed, placement, json_output, out, model, weights):
             raise typer.Exit(1)
         return
     for flag, value in (("--placement", placement), ("--write-problems", write_problems)):
@@ -80,7 +72,7 @@ def fetch_command(
         from ..viz3d import require_meshcat
 
         require_meshcat()
-    collision = collision or "graphdistnet"
+    collision = "graphdistnet" if collision is None else collision
     stages = run_fetch(seed, collision=collision, weights=weights)
     ok = all(s.success for s in stages)
     if json_output:
@@ -104,3 +96,25 @@ def fetch_command(
         view_plan([(s.scene, s.q) for s in stages])
     if not ok:
         raise typer.Exit(1)
+
+
+def _check_3d_options(animate, view3d: bool, collision: str | None, weights: str | None) -> None:
+    """InputError naming the first option the 3-D fetch does not take, and what to do."""
+    from ..errors import InputError
+
+    if animate is not None or view3d:
+        flag = "--animate" if animate is not None else "--view3d"
+        raise InputError(
+            f"{flag}: the 3-D fetch draws no GIF or browser view yet; write its stages with "
+            "--write-problems DIR and view one with gdnplan plan DIR/fetch3d_<stage>.toml "
+            f"{flag}{' out.gif' if flag == '--animate' else ''}"
+        )
+    if collision not in (None, "coal", "graphdistnet"):
+        raise InputError(
+            f"--collision: expected coal or graphdistnet for the 3-D fetch, got {collision!r}"
+        )
+    if weights is not None and collision != "graphdistnet":
+        raise InputError(
+            "--weights: the 3-D fetch takes weights only with --collision graphdistnet "
+            "(weights trained on ur5e_storage)"
+        )
