@@ -115,7 +115,8 @@ def test_a_malformed_collision_is_refused_naming_link_and_attribute(
         ('<origin xyz="0.5 0 0"/>', '<origin xyz="0.5 0 0" quat_xyzw="0 0 0 1"/>', "elbow"),
         ('lower="-2.6" upper="2.6"', 'lower="-1e300" upper="1e300"', "joint 'elbow'.*±1000"),
         ('lower="-2.6" upper="2.6"', 'lower="2.6" upper="-2.6"', "joint 'elbow'.*lower > upper"),
-        ('lower="-2.6" upper="2.6"', 'lower="1" upper="1"', "joint 'elbow'.*lower < upper"),
+        ('lower="-2.6" upper="2.6"', 'lower="1" upper="1"', "joint 'elbow'.*upper − lower ≥"),
+        ('lower="-2.6" upper="2.6"', 'lower="0" upper="1e-300"', "joint 'elbow'.*upper − lower"),
         ('lower="-2.6" upper="2.6"', 'lower="-2.6" upper="nan"', "elbow|limit|double"),
         ('lower="-1.6" upper="1.6"', 'lower="1.6" upper="-1.6"', "joint 'tool_roll'"),
     ],
@@ -124,6 +125,26 @@ def test_bad_joint_origins_and_limits_are_refused_naming_the_joint(
     tmp_path, capfd, kind, old, new, match
 ):
     refused(mutated(tmp_path, old, new), kind, match, capfd)
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("joints", "shoulder"),
+        ("joints", ["shoulder", 3]),
+        ("locked", [("tool_roll", 0.1)]),
+        ("locked", {1: 0.1}),
+        ("package_dirs", "/tmp"),
+        ("package_dirs", [None]),
+        ("name", 123),
+        ("name", " "),
+    ],
+)
+def test_robot3d_arguments_of_the_wrong_kind_are_refused_naming_them(field, value):
+    """A bare string where a list is meant iterated as its characters ('j0' → 'j', '0'), a
+    list of pairs where a table is meant raised AttributeError, a number was a name."""
+    with pytest.raises(InputError, match=rf"^{field}: expected"):
+        robot3d_from_urdf(EXAMPLE, **{field: value})
 
 
 def test_a_locked_joint_may_have_equal_limits(tmp_path):

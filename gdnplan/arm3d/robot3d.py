@@ -32,6 +32,7 @@ from ..urdf_robot import RobotSpec, load_urdf
 from ..urdf_robot.joint_limits import check_joint_limits
 from ..urdf_robot.load import check_mimic
 from ..urdf_robot.locking import lock_mimics, set_locked
+from ..urdf_robot.spec import check_folders, check_locked, check_names
 from .pairs import contact_only_mask, self_collision_pairs
 from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
 
@@ -210,7 +211,12 @@ def robot3d_from_urdf(
             of order, a locked value outside its limits.
     """
     path = Path(urdf)
-    dirs = tuple(str(d) for d in package_dirs)
+    dirs = check_folders(package_dirs)
+    if joints is not None:
+        joints = check_names(joints, "joints", "joint names")
+    locked = check_locked(locked or {})
+    if name is not None and (not isinstance(name, str) or not name.strip()):
+        raise InputError(f"name: expected a robot name (a string) or None, got {name!r}")
     model, geom = load_urdf(
         RobotSpec(urdf=path, planning_joints=tuple(joints or ()), package_dirs=dirs)
     )

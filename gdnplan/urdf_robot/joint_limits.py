@@ -20,6 +20,7 @@ import pinocchio as pin
 from ..errors import InputError
 
 MAX_LIMIT = 1e3  # rad (m for prismatic): largest |lower| or |upper| of a joint
+MIN_RANGE = 1e-6  # rad (m): smallest upper − lower of a planning joint (one that can move)
 CONTINUOUS_VELOCITY = 1.0  # rad/s: a continuous planning joint's speed without a <limit>
 
 
@@ -48,7 +49,8 @@ def unlimit_effort(model: pin.Model, names: Sequence[str]) -> None:
 
 def check_joint_limits(model: pin.Model, planning: Sequence[str], path: Path) -> None:
     """InputError naming the first revolute or prismatic joint of ``model`` whose limits are
-    not finite, beyond ``MAX_LIMIT``, or reversed; or a planning joint with lower = upper."""
+    not finite, beyond ``MAX_LIMIT``, or reversed; or a planning joint whose range is below
+    ``MIN_RANGE``."""
     for j in range(1, model.njoints):
         joint, name = model.joints[j], model.names[j]
         if joint.nq != 1 or joint.nv != 1:
@@ -64,8 +66,8 @@ def check_joint_limits(model: pin.Model, planning: Sequence[str], path: Path) ->
             )
         if lo > hi:
             raise InputError(f"{where}: lower > upper; swap them")
-        if lo == hi and name in planning:
+        if hi - lo < MIN_RANGE and name in planning:
             raise InputError(
-                f"{where}: a planning joint needs lower < upper (it cannot move); give its "
-                "range or lock it"
+                f"{where}: a planning joint needs upper − lower ≥ {MIN_RANGE:g} {unit} (it "
+                "cannot move); give its range or lock it"
             )

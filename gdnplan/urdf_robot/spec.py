@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from ..errors import InputError
 
 
 @dataclass(frozen=True)
@@ -31,3 +34,39 @@ class RobotSpec:
     package_dirs: tuple[str, ...] = ()
     max_vertices: int = 12
     base_radius: float = 0.15
+
+    def __post_init__(self) -> None:
+        names = check_names(self.planning_joints, "planning_joints", "joint names")
+        object.__setattr__(self, "planning_joints", names)
+        object.__setattr__(self, "locked", check_locked(self.locked))
+        object.__setattr__(self, "package_dirs", check_folders(self.package_dirs))
+
+
+def check_names(value, field_name: str, what: str) -> tuple[str, ...]:
+    """``value`` as a tuple of strings, else InputError naming ``field_name``: a bare string
+    is refused (it would iterate as its characters)."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)):
+        raise InputError(f"{field_name}: expected a list of {what}, got {value!r}")
+    bad = [x for x in value if not isinstance(x, str)]
+    if bad:
+        raise InputError(f"{field_name}: expected a list of {what}, got {bad[0]!r} in it")
+    return tuple(value)
+
+
+def check_locked(locked) -> dict[str, float]:
+    """``locked`` as a dict {joint name: value}, else InputError (its values are checked
+    against the joints' limits when the model is known)."""
+    if not isinstance(locked, Mapping) or not all(isinstance(k, str) for k in locked):
+        raise InputError(f"locked: expected a table {{joint name: value}}, got {locked!r}")
+    return dict(locked)
+
+
+def check_folders(folders) -> tuple[str, ...]:
+    """``package_dirs`` as a tuple of folder strings, else InputError (a bare string would
+    iterate as its characters)."""
+    if isinstance(folders, (str, bytes, Path)) or not isinstance(folders, (list, tuple)):
+        raise InputError(f"package_dirs: expected a list of folders, got {folders!r}")
+    bad = [d for d in folders if not isinstance(d, (str, Path))]
+    if bad:
+        raise InputError(f"package_dirs: expected a list of folders, got {bad[0]!r} in it")
+    return tuple(str(d) for d in folders)
