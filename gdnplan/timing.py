@@ -45,7 +45,14 @@ from .ccd_curve import certify_curve
 from .errors import InputError
 from .limits import MAX_TIMED_SAMPLES, check_number
 from .scene import Scene
-from .timing_checks import LIMIT_RANGE, MAX_ANGLE, check_waypoints, limit_vector, urdf_velocity
+from .timing_checks import (
+    LIMIT_RANGE,
+    MAX_ANGLE,
+    check_scene_dof,
+    check_waypoints,
+    limit_vector,
+    urdf_velocity,
+)
 from .timing_profiles import LinearProfile, StopProfile
 from .timing_toppra import cell_bounds, chord_knots, toppra_profile
 
@@ -132,6 +139,8 @@ def time_path(
     """
     check_number(clearance, "clearance")
     q = check_waypoints(q)
+    if scene is not None:
+        check_scene_dof(scene, q.shape[1])
     v = limit_vector(max_velocity, q.shape[1], "max_velocity", "rad/s")
     if max_acceleration is None:
         prof = LinearProfile(q, v)

@@ -72,4 +72,22 @@ def urdf_velocity(robot: Robot | Robot3D) -> np.ndarray:
     return v
 
 
-__all__ = ["LIMIT_RANGE", "MAX_ANGLE", "check_waypoints", "limit_vector", "urdf_velocity"]
+def check_scene_dof(scene, dof: int) -> None:
+    """InputError unless ``scene`` is a scene whose robot has ``dof`` joints (the path's
+    columns)."""
+    robot = getattr(scene, "robot", None)
+    joints = getattr(robot, "dof", None)
+    if joints is None:
+        raise InputError(f"scene: expected a Scene or Scene3D, got {type(scene).__name__}")
+    if joints != dof:
+        raise InputError(f"scene: its robot has {joints} joints, q has {dof} columns")
+
+
+__all__ = [
+    "LIMIT_RANGE",
+    "MAX_ANGLE",
+    "check_scene_dof",
+    "check_waypoints",
+    "limit_vector",
+    "urdf_velocity",
+]

@@ -115,9 +115,11 @@ UR5E_Q = np.array([0.2, -1.3, 1.5, -1.8, -1.57, 0.4])
         ({"position_tol": 1e-300}, "position_tol: 1e-300 is below 1e-12"),
         ({"rotation_tol": 1e-13}, "rotation_tol: 1e-13 is below 1e-12"),
         ({"position_tol": float("nan")}, "position_tol"),
+        ({"position_tol": 1e10}, "position_tol: 1e\\+10 m is over 1 m"),
+        ({"rotation_tol": 4.0}, "rotation_tol: 4 rad is over 3.14159 rad"),
     ],
 )
-def test_tolerances_below_what_the_solver_reaches_are_refused(kwargs, match):
+def test_tolerances_the_solver_cannot_honour_are_refused(kwargs, match):
     robot = load_robot3d("ur5e")
     target = _fk(robot, UR5E_Q, "gripper_tcp")
     with pytest.raises(InputError, match=match):

@@ -95,3 +95,23 @@ def test_the_3d_fetch_with_learned_constraints_is_certified(capsys):
     assert exit_.value.code in (0, None)
     summary = json.loads(capsys.readouterr().out)
     assert summary["success"] and all(s["success"] for s in summary["stages"])
+
+
+@pytest.mark.parametrize("text", ["0.6,,0", "0.6,0.2,", ",0.6,0.2,0", "0.6, ,0.2"])
+def test_a_placement_with_an_empty_field_is_refused_not_shortened(text):
+    from gdnplan.cli.fetch3d import parse_placement
+    from gdnplan.errors import InputError
+
+    with pytest.raises(InputError, match="--placement: an empty field"):
+        parse_placement(text)
+
+
+def test_a_placement_yaw_is_wrapped_exactly():
+    import math
+
+    from gdnplan.cli.fetch3d import parse_placement
+
+    assert parse_placement("0.6 0.1 0.3") == parse_placement("0.6, 0.1, 0.3")
+    wrapped = parse_placement(f"0.6,0.1,{0.3 + 4 * math.pi!r}")
+    assert abs(wrapped.yaw - 0.3) < 1e-12
+    assert -math.pi <= parse_placement("0.6,0.1,1e10").yaw <= math.pi

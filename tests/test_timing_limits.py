@@ -97,3 +97,12 @@ def test_sample_of_a_long_trajectory_with_a_tiny_dt_is_refused():
     traj = time_path(np.array([[0.0], [1e6]]), 1e-6)
     with pytest.raises(gp.InputError, match="dt"):
         traj.sample(1e-300)
+
+
+def test_a_scene_whose_robot_does_not_match_the_path_is_refused(free2):
+    q = np.zeros((3, 3))
+    q[1:, 0] = [0.2, 0.4]
+    with pytest.raises(gp.InputError, match=r"^scene: its robot has 2 joints, q has 3 columns"):
+        time_path(q, 1.0, 1.0, free2)
+    with pytest.raises(gp.InputError, match=r"^scene: expected a Scene"):
+        time_path(q, 1.0, 1.0, "a")

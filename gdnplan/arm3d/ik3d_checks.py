@@ -5,6 +5,8 @@ before any IK is solved.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import InputError
@@ -12,6 +14,8 @@ from ..limits import check_int, check_number
 from .shapes import as_vector
 
 MIN_TOL = 1e-12  # m, rad: smallest position_tol / rotation_tol (the DLS reaches ~1e-14 at 1 m)
+MAX_POSITION_TOL = 1.0  # m: largest position_tol (an arm's reach)
+MAX_ROTATION_TOL = math.pi  # rad: largest rotation_tol (any orientation is within π)
 MAX_POINTS = 10_000  # cartesian_path: positions of one path
 MAX_IK_COUNT = 100_000  # restarts, solutions and iterations of one solve_pose_ik call
 
@@ -26,15 +30,23 @@ def check_ik_settings(
 ) -> None:
     """InputError naming the first setting of :func:`~gdnplan.arm3d.ik3d.solve_pose_ik` out of
     range: ``margin`` finite (m); ``restarts``, ``solutions``, ``iterations`` integers in
-    1 … :data:`MAX_IK_COUNT`; ``position_tol`` (m), ``rotation_tol`` (rad) finite and
-    ≥ :data:`MIN_TOL`."""
+    1 … :data:`MAX_IK_COUNT`; ``position_tol`` in [:data:`MIN_TOL`, :data:`MAX_POSITION_TOL`]
+    (m), ``rotation_tol`` in [:data:`MIN_TOL`, π] (rad)."""
     check_number(margin, "margin", -np.inf)
     check_int(restarts, "restarts", 1, MAX_IK_COUNT)
     check_int(solutions, "solutions", 1, MAX_IK_COUNT)
     check_int(iterations, "iterations", 1, MAX_IK_COUNT)
-    for name, tol in (("position_tol", position_tol), ("rotation_tol", rotation_tol)):
+    for name, tol, high, unit in (
+        ("position_tol", position_tol, MAX_POSITION_TOL, "m"),
+        ("rotation_tol", rotation_tol, MAX_ROTATION_TOL, "rad"),
+    ):
         if check_number(tol, name, 0.0, strict=True) < MIN_TOL:
             raise InputError(f"{name}: {tol:g} is below {MIN_TOL:g}, what the IK solver reaches")
+        if tol > high:
+            raise InputError(
+                f"{name}: {tol:g} {unit} is over {high:g} {unit}: no pose would be missed; "
+                "give the error you accept"
+            )
 
 
 def check_positions(positions) -> np.ndarray:

@@ -23,6 +23,7 @@ Tool poses (the UR5e's ``gripper_tcp``, :mod:`gdnplan.arm3d.ik3d`): the tool axi
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -219,11 +220,13 @@ def random_placement(rng: np.random.Generator) -> Placement:
 
 
 def check_placement(x, y, yaw) -> Placement:
-    """A placement from user numbers: finite x, y (m) and yaw (rad); InputError otherwise."""
+    """A placement from user numbers: finite x, y (m) and yaw (rad), the yaw wrapped into
+    [−π, π] (exactly: ``math.remainder``; sin/cos of 1e10 rad lose six digits); InputError
+    otherwise."""
     if not all(is_number(v) and np.isfinite(v) for v in (x, y, yaw)):
         shown = [v.item() if isinstance(v, np.generic) else v for v in (x, y, yaw)]
         raise InputError(f"placement: expected finite x, y (m) and yaw (rad), got {shown}")
-    values = [float(x), float(y), float(yaw)]
+    values = [float(x), float(y), math.remainder(float(yaw), 2 * math.pi)]
     if np.hypot(values[0], values[1]) > 2.0:
         raise InputError(f"placement: ({x}, {y}) m is farther than 2 m from the robot")
     return Placement(*values)

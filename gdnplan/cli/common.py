@@ -85,11 +85,15 @@ def set_threads(threads: int, torch_global: bool = False) -> None:
 
 
 def parse_vector(text: str, name: str) -> np.ndarray:
-    """'0.1, -0.2, 0.3' -> array; raises InputError naming ``name``."""
+    """'0.1, -0.2, 0.3' (or '0.1 -0.2 0.3') -> array; raises InputError naming ``name``
+    (an empty field, as in '0.6,,0', is refused, not skipped)."""
     import numpy as np
 
+    fields = text.split(",") if "," in text else text.split()
+    if any(not f.strip() for f in fields):
+        raise InputError(f"{name}: an empty field in {text!r}; separate numbers by one comma")
     try:
-        return np.array([float(v) for v in text.replace(",", " ").split()])
+        return np.array([float(v) for v in fields])
     except ValueError as e:
         raise InputError(f"{name}: expected numbers separated by commas, got {text!r}") from e
 
