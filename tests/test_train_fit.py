@@ -167,3 +167,34 @@ def test_validation_split_is_a_seeded_partition_with_a_tenth_held_out(n, seed):
 def test_bad_schedules_name_the_field(changes, field):
     with pytest.raises(InputError, match=rf"^{field}: "):
         FitConfig(**changes)
+
+
+@settings(max_examples=4, deadline=None)
+@given(weight=st.sampled_from([1e308, 1e300, 1e250]), checkpointed=st.booleans())
+def test_a_diverging_run_is_refused_before_its_nan_weights_are_kept(
+    tmp_path_factory, weight, checkpointed
+):
+    """Audit: ``gdnplan train --set grad_weight=1e308`` gave a NaN validation score; no epoch
+    was kept, the checkpoint dropped its ``best_state`` key and the run exited with KeyError
+    (a rerun then refused the NaN checkpoint as 'shipped weights'). Now one InputError naming
+    the fix, and no checkpoint of NaN weights."""
+    ds = shard("a", 40)
+    tr, val = validation_split(len(ds), 0)
+    torch.manual_seed(0)
+    net = GraphDistNet(GraphDistNetConfig(layers=1, hidden=8, mlp=(8,), readout=(8,)))
+    loss = GraphDistNetLoss(grad_weight=weight)
+    learner = GraphDistNetLearner(net, tensors(ds.subset(tr)), tensors(ds.subset(val)), loss)
+    ckpt = tmp_path_factory.mktemp("run") / "checkpoint.safetensors" if checkpointed else None
+    with pytest.raises(InputError, match=r"training diverged at epoch 0 .*--lr"):
+        fit(learner, FitConfig(batch=16, epochs=2, seed=0), checkpoint=ckpt)
+    assert ckpt is None or not ckpt.exists()
+
+
+def test_a_checkpoint_without_a_best_state_keeps_the_key(tmp_path):
+    from gdnplan.train.checkpoint import save_checkpoint
+    from gdnplan.train.fit import new_state
+
+    net = torch.nn.Linear(2, 1)
+    state = new_state(1e-3)
+    save_checkpoint(tmp_path / "c.safetensors", net, torch.optim.Adam(net.parameters()), state)
+    assert state["best_state"] is None

@@ -29,8 +29,7 @@ def save_checkpoint(path: Path, net: torch.nn.Module, opt: torch.optim.Adam, sta
     try:
         write_weights(path, tensors, state, "checkpoint")
     finally:
-        if best is not None:
-            state["best_state"] = best
+        state["best_state"] = best  # None too: the loop reads the key after the epochs
 
 
 def load_checkpoint(path: Path, net: torch.nn.Module, opt: torch.optim.Adam) -> dict:

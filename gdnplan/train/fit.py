@@ -197,6 +197,21 @@ def _start(
     return state
 
 
+def check_finite_epoch(entry: dict, checkpoint: Path | None) -> None:
+    """InputError unless the epoch's training loss and validation score are finite: a run
+    that diverged (a learning rate or loss weight too large) has NaN weights, which are
+    neither kept nor checkpointed (the last checkpoint stays, from the last finite epoch)."""
+    loss, score = entry["train_loss"], entry["val_score"]
+    if math.isfinite(loss) and math.isfinite(score):
+        return
+    kept = f"; {checkpoint} keeps the last finite epoch" if checkpoint is not None else ""
+    raise InputError(
+        f"training diverged at epoch {entry['epoch']} (train_loss {loss}, val_score {score}): "
+        f"lower the learning rate (--lr, now {entry['lr']:g}) or the loss weights (--set "
+        f"grad_weight=…, contact_weight=…){kept}"
+    )
+
+
 def fit(
     learner: Learner,
     c: FitConfig,
@@ -240,8 +255,9 @@ def fit(
         val = learner.validate()
         entry = {"epoch": epoch, "train_loss": total / n, **val, "lr": state["lr"]}
         entry.update(seconds=seconds, samples_per_s=n / seconds)
-        state["log"].append(entry)
         say(json.dumps(entry))
+        check_finite_epoch(entry, checkpoint)
+        state["log"].append(entry)
         _select(state, val["val_score"], learner.net, opt)
         state["epoch"] = epoch + 1
         if checkpoint is not None:
