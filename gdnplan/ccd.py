@@ -111,7 +111,8 @@ def proven_distance(d_coal: np.ndarray, swept: float = 0.0) -> np.ndarray:
     d_coal = np.asarray(d_coal, float)
     finite = np.where(np.isposinf(d_coal), 0.0, d_coal)
     slack = COAL_SLACK * (1.0 + np.abs(finite) + swept)
-    return np.where(np.isposinf(d_coal), np.inf, finite - slack)
+    with np.errstate(over="ignore"):  # d_coal near −DBL_MAX: −inf, still a lower bound
+        return np.where(np.isposinf(d_coal), np.inf, finite - slack)
 
 
 @dataclass(frozen=True)
