@@ -39,11 +39,38 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..distance import signed_distance
+from ..errors import InputError
+from ..limits import check_int
 from ..robot import Robot, make_rng
 from ..scene import Scene, check_scene
+from .fields import check_real
 
 CHUNK = 1024  # query rows per kernel block
 FIT_MAX = 3000  # labelled configurations in the fitted surrogate
+MAX_POOL = 10_000  # labelled configurations of one perceptron fit: an n² kernel (800 MB)
+MAX_FASTRON_ITER = 10**8  # perceptron updates of one fit
+
+
+def check_training(gamma: object, beta: object, margin: object, max_iter: object) -> None:
+    """InputError naming the first setting out of its range: ``gamma`` in [1e-6, 1e6] m⁻²,
+    ``beta`` in [1e-6, 1e6], ``margin`` in [−10, 10] m, ``max_iter`` in 1 … 10⁸."""
+    check_real("gamma", gamma, 1e-6, 1e6, " m⁻²")
+    check_real("beta", beta, 1e-6, 1e6)
+    check_real("margin", margin, -10.0, 10.0, " m")
+    check_int(max_iter, "max_iter", 1, MAX_FASTRON_ITER)
+
+
+def same_kinematics(a: Robot, b: Robot) -> bool:
+    """True when robots ``a`` and ``b`` have one name, joint count, limits and node positions
+    (DiffCo's control points) at their lower, upper and middle configurations."""
+    if a is b:
+        return True
+    if (a.name, a.dof, a.n_nodes) != (b.name, b.dof, b.n_nodes):
+        return False
+    if not (np.array_equal(a.lower, b.lower) and np.array_equal(a.upper, b.upper)):
+        return False
+    probe = np.stack([a.lower, a.upper, (a.lower + a.upper) / 2])
+    return bool(np.array_equal(a.node_positions(probe), b.node_positions(probe)))
 
 
 @dataclass(frozen=True)
@@ -63,7 +90,7 @@ class FKKernel:
     def features(self, q: np.ndarray) -> np.ndarray:
         """(B, 2N) control points of q (B, dof), flattened and scaled by 1/√N (m)."""
         x = self.robot.node_positions(q)
-        return x.reshape(len(x), -1) / np.sqrt(x.shape[1])
+        return x.reshape(len(x), 2 * x.shape[1]) / np.sqrt(x.shape[1])  # (0, 2N) when B = 0
 
     def from_features(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Kernel (A, B) and ∂k/∂r² (A, B) between feature rows a (A, 2N) and b (B, 2N)."""
@@ -156,8 +183,12 @@ class DiffCo:
         margin: float = 0.0,
         max_iter: int = 20_000,
     ) -> DiffCo:
-        """Train on n uniform configurations of ``scene`` labelled by coal."""
-        kernel = FKKernel(scene.robot, gamma)
+        """Train on n uniform configurations of ``scene`` labelled by coal (``n`` in 1 …
+        :data:`MAX_POOL`; the other settings: :func:`check_training`)."""
+        check_scene(scene, "planar")
+        check_int(n, "n", 1, MAX_POOL, "the kernel matrix is n² numbers")
+        check_training(gamma, beta, margin, max_iter)
+        kernel = FKKernel(scene.robot, float(gamma))
         q = scene.robot.sample(n, seed=seed)
         d = signed_distance(scene, q)
         model = cls(kernel, q[:0], np.zeros(0), q, d, beta=beta, margin=margin)
@@ -194,6 +225,11 @@ class DiffCo:
             A new DiffCo (perceptron score; call :meth:`fitted` for the surrogate).
         """
         robot = self.kernel.robot
+        self.check_robot(scene)
+        pool = len(self.support) * (1 + check_int(n_exploit, "n_exploit", 0, MAX_POOL))
+        check_int(n_explore, "n_explore", 0, MAX_POOL - pool, f"at most {MAX_POOL} in all")
+        sigma = check_real("sigma", sigma, 0.0, 10.0, " rad")
+        check_int(max_iter, "max_iter", 1, MAX_FASTRON_ITER)
         rng = make_rng(seed)
         near = np.repeat(self.support, n_exploit, 0)
         near = np.clip(near + rng.normal(0, sigma, near.shape), robot.lower, robot.upper)
@@ -203,7 +239,9 @@ class DiffCo:
         return self._fit(q, d, alpha0, max_iter)
 
     def fitted(self) -> DiffCo:
-        """The smooth surrogate: kernel ridge regression of coal's f over the labelled pool."""
+        """The smooth surrogate: kernel ridge regression of coal's f over the labelled pool
+        (``ridge`` λ in [0, 1e6])."""
+        check_real("ridge", self.ridge, 0.0, 1e6)
         feats = self.kernel.features(self.pool[:FIT_MAX])
         K = self.kernel.matrix(feats, feats) + self.ridge * np.eye(len(feats))
         w = np.linalg.solve(K, self.pool_d[:FIT_MAX])
@@ -220,9 +258,22 @@ class DiffCo:
         """(S,) the weights of the returned value: −α (score) or w (fitted surrogate)."""
         return -self.alpha if self.fit_weights is None else self.fit_weights
 
-    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
-        """(B,) −s(q) (or the fitted surrogate); ``scene`` only checks q (obstacles unused)."""
+    def check_robot(self, scene: Scene) -> None:
+        """InputError unless ``scene`` is planar and its robot is the one DiffCo was trained
+        for (:func:`same_kinematics`): its control points are that robot's nodes."""
         check_scene(scene, "planar")
+        mine, have = self.kernel.robot, scene.robot
+        if not same_kinematics(mine, have):
+            raise InputError(
+                f"scene: this DiffCo was trained for the {mine.name} robot ({mine.dof} joints) "
+                f"and the scene's robot is {have.name} ({have.dof} joints) with other "
+                "kinematics; train DiffCo in a scene of this robot (DiffCo.train)"
+            )
+
+    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        """(B,) −s(q) (or the fitted surrogate); ``scene`` only checks the robot and q
+        (obstacles unused)."""
+        self.check_robot(scene)
         q = scene.robot.check_q(q)
         feats = self.kernel.features(q)
         sf = self.kernel.features(self.centers)
@@ -240,11 +291,11 @@ class DiffCo:
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)) the value and its exact gradient through the node Jacobians."""
-        check_scene(scene, "planar")
+        self.check_robot(scene)
         q = scene.robot.check_q(q)
         n_nodes = self.kernel.robot.n_nodes
         feats = self.kernel.features(q)  # (B, 2N) = x / √N
-        jac = self.kernel.robot.node_jacobians(q).reshape(len(q), 2 * n_nodes, -1)
+        jac = self.kernel.robot.node_jacobians(q).reshape(len(q), 2 * n_nodes, q.shape[1])
         sf = self.kernel.features(self.centers)
         value, grad = np.empty(len(q)), np.empty(q.shape)
         for s in range(0, len(q), CHUNK):
