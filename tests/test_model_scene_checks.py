@@ -4,6 +4,8 @@ InputError naming ``scene`` (not an AttributeError from inside), like the exact 
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 import gdnplan as gp
 from gdnplan.arm3d import Scene3D, load_robot3d
@@ -15,7 +17,13 @@ WRONG = [None, "b", 5, np.zeros(3), object()]
 
 
 def entries(model) -> list:
-    names = ["distance", "distance_and_grad", "learned_distance", "learned_distance_and_grad"]
+    names = [
+        "distance",
+        "distance_and_grad",
+        "distance_deferred_grad",  # audit: GraphDistNet's raised AttributeError on None
+        "learned_distance",
+        "learned_distance_and_grad",
+    ]
     return [getattr(model, n) for n in names if hasattr(model, n)]
 
 
@@ -44,3 +52,20 @@ def test_diffco_refuses_other_scenes(scene):
     for entry in entries(model):
         with pytest.raises(InputError, match="scene"):
             entry(scene, np.zeros(2))
+
+
+@pytest.mark.parametrize("weights", ["b", "b_faithful", "clearancenet_b"])
+@settings(max_examples=6, deadline=None)
+@given(b=st.integers(0, 40))
+@example(b=0)
+def test_every_batch_size_gives_arrays_of_that_size(weights, b):
+    """Audit: ClearanceNet's empty batch (0, dof) raised numpy's 'need at least one array to
+    concatenate'; every planar model now returns (0,) and (0, dof) as coal does."""
+    model = gp.load_model(weights)
+    q = PLANAR.robot.sample(b, seed=2)
+    d, g = model.distance_and_grad(PLANAR, q)
+    assert d.shape == (b,) and g.shape == (b, 2)
+    assert model.distance(PLANAR, q).shape == (b,)
+    if hasattr(model, "distance_deferred_grad"):
+        d, grad = model.distance_deferred_grad(PLANAR, q)
+        assert d.shape == (b,) and grad().shape == (b, 2)

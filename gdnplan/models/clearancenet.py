@@ -206,6 +206,8 @@ class ClearanceNetModel:
             return self._run_chunks(q, obst, grad)
 
     def _run_chunks(self, q: np.ndarray, obst: np.ndarray, grad: bool):
+        if len(q) == 0:  # an empty batch: empty (0,) and (0, dof) arrays, as coal gives
+            return np.zeros(0), (np.zeros(q.shape) if grad else None)
         ds, gs = [], []
         for s in range(0, len(q), self.chunk):
             qt = torch.as_tensor(q[s : s + self.chunk], dtype=self.dtype)

@@ -143,6 +143,9 @@ class GraphDistNetModel:
         """(B,) estimated signed distances (m) of q (B, dof) or (dof,)."""
         check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
+        if len(q) == 0:  # an empty batch (the network has no empty pass): (0,)
+            self._graphs(scene)  # the scene is still checked
+            return np.zeros(0)
         with torch_threads(self.threads) as threads:
             graphs = self._graphs(scene)  # outside inference mode: the cache serves autograd too
             if graphs.whole is not None:
@@ -161,6 +164,9 @@ class GraphDistNetModel:
         """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad)."""
         check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
+        if len(q) == 0:  # an empty batch: (0,) and (0, dof), the scene still checked
+            self._graphs(scene)
+            return np.zeros(0), np.zeros(q.shape)
         with torch_threads(self.threads) as threads:
             graphs = self._graphs(scene)
             if graphs.whole is not None:
@@ -187,7 +193,11 @@ class GraphDistNetModel:
         cheaper than a second forward for the 70 % or so of planner calls that ask for it
         (docs/decisions.md, 2026-12-02 fused2).
         """
+        check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
+        if len(q) == 0:
+            d, g = self.distance_and_grad(scene, q)
+            return d, lambda: g
         threads = self.threads
         with torch_threads(threads) as count:
             graphs = self._graphs(scene)
