@@ -314,8 +314,9 @@ GRAPHDISTNET_ONLY = {"--preset", "--name", "--set", "--run-dir", "--compile", "-
 
 
 @pytest.fixture
-def captured_training(monkeypatch):
-    """Replace both trainers by recorders of what the command gives them (nothing trains)."""
+def captured_training(monkeypatch, tmp_path):
+    """Replace both trainers by recorders of what the command gives them (nothing trains);
+    run from an empty folder (the default weights/<env> is then no shipped file)."""
     import torch
 
     import gdnplan.train
@@ -336,6 +337,7 @@ def captured_training(monkeypatch):
 
     monkeypatch.setattr(gdnplan.train, "train", graphdistnet)
     monkeypatch.setattr(gdnplan.train, "train_and_score", clearancenet)
+    monkeypatch.chdir(tmp_path)
     yield calls
     torch.set_num_threads(threads)
 
@@ -421,3 +423,25 @@ def test_a_plan_without_obstacles_says_so_not_that_its_clearance_is_unproven(tmp
     assert "certified collision-free; nothing to collide with (no obstacles)" in result.output
     assert clearance_text(float("-inf")) == clearance_text(float("nan")) == "clearance not proven"
     assert clearance_text(0.0123) == "certified clearance ≥ +0.0123 m"
+
+
+@pytest.mark.parametrize("model", ["graphdistnet", "clearancenet"])
+def test_training_never_replaces_shipped_weights_unless_asked(
+    model, captured_training, tmp_path, capsys
+):
+    """From the repository root weights/ is the shipped folder: a bare `gdnplan train` (or an
+    --out into it) would silently replace what every plan by that name uses."""
+    from gdnplan.assets import WEIGHTS_DIR
+    from gdnplan.cli import run
+
+    (tmp_path / "weights").symlink_to(WEIGHTS_DIR)  # as in the repository root
+    name = "clearancenet_a" if model == "clearancenet" else "a"
+    for args in ([], ["--out", str(WEIGHTS_DIR / f"{name}.safetensors")]):
+        with pytest.raises(SystemExit) as exit_:
+            run(["train", "--env", "a", "--model", model, *args])
+        err = capsys.readouterr().err
+        assert exit_.value.code == 2 and "is a shipped weights file" in err, err
+        assert "--replace-shipped" in err and not captured_training
+    with pytest.raises(SystemExit) as exit_:
+        run(["train", "--env", "a", "--model", model, "--replace-shipped"])
+    assert exit_.value.code == 0 and captured_training["kind"] == model

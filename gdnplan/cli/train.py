@@ -128,6 +128,12 @@ def train_command(
         help="More GraphDistNet training shards (a directory, e.g. from generate --near); "
         "repeatable.",
     ),
+    replace_shipped: bool = typer.Option(
+        False,
+        "--replace-shipped",
+        help="Allow the weights to replace a shipped weights file (how the shipped ones are "
+        "reproduced; every plan by that name then uses the new weights).",
+    ),
 ) -> None:
     """Train a model on data/<env>/train, score it on data/<env>/test, write weights + card.
 
@@ -143,17 +149,21 @@ def train_command(
         time_budget = CLEARANCENET_BUDGET
     schedule = FitConfig(batch, lr, epochs, patience, time_budget, seed, device)
     init = None if init is None else weights_file(init)
+    default = f"clearancenet_{env}" if model == "clearancenet" else env
+    target = out if out is not None else Path("weights") / f"{default}.safetensors"
     if out is not None:
         check_output_path(out, (".safetensors",), "--out")
         check_output_path(out.with_suffix(".json"), (".json",), "--out")
     if run_dir is not None:
         check_output_dir(run_dir, "--run-dir")
     if model == "clearancenet":
+        check_not_shipped(target, replace_shipped)
         set_threads(threads, torch_global=True)
         card = _train_clearancenet(env, schedule, out, n_train, data or DATA_DIR)
         typer.echo(json.dumps({"env": env, **card["test"]}, indent=2))
         return
     config = _graphdistnet_run(preset, set_, init, schedule, n_train, extra, compile)
+    check_not_shipped(target, replace_shipped)
     set_threads(threads, torch_global=True)
     from .. import train as training
 
@@ -162,6 +172,23 @@ def train_command(
         run_dir=run_dir,
     )  # fmt: skip
     typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
+
+
+def check_not_shipped(target: Path, replace: bool) -> None:
+    """InputError when ``target`` (the weights to write) is an existing shipped weights file
+    (``gdnplan.assets.WEIGHTS_DIR``; from the repository root ``weights/`` is that folder)
+    and ``replace`` is off: a training run would silently change what every plan by that
+    name uses and what the README's figures were measured with."""
+    from ..assets import WEIGHTS_DIR
+
+    resolved = target.resolve()
+    shipped = WEIGHTS_DIR.resolve()
+    pair = (resolved, resolved.with_suffix(".json"))
+    if not replace and resolved.parent == shipped and any(p.exists() for p in pair):
+        raise InputError(
+            f"--out: {target} is a shipped weights file ({resolved.stem}); give another --out "
+            "(e.g. my_weights.safetensors) or --replace-shipped to replace it"
+        )
 
 
 def _check_model(model: str, graphdistnet_only: tuple) -> None:
