@@ -18,6 +18,7 @@ would call the callback per nonzero).
 from __future__ import annotations
 
 import inspect
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -26,8 +27,9 @@ import numpy as np
 
 from .distance import checker, witness_gradient
 from .errors import InputError
+from .limits import check_int, is_number
 from .models import CoalModel, DistanceModel
-from .scene import Scene
+from .scene import Scene, check_scene
 
 BatchFn = Callable[[np.ndarray], tuple[np.ndarray, Callable[[], np.ndarray]]]
 
@@ -109,6 +111,31 @@ def block_sparsity(k: int, rows: int, dof: int) -> casadi.Sparsity:
     return casadi.kron(casadi.Sparsity.diag(k), casadi.Sparsity.dense(rows, dof))
 
 
+MAX_POINTS = 10**6  # n_points: configurations of one callback call
+_CASADI_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+
+
+def check_callback(name, model, scene, n_points, per_link, cap) -> None:
+    """InputError naming the first bad argument of :class:`DistanceCallback`: ``name`` a
+    CasADi name (a letter, then letters, digits, _), ``model`` a distance model fit for
+    ``scene`` (its ``check_scene``), ``n_points`` an integer in 1 … :data:`MAX_POINTS`,
+    ``per_link`` a bool, ``cap`` a number > 0 (m; +inf: no cap)."""
+    if not isinstance(name, str) or not _CASADI_NAME.match(name):
+        raise InputError(
+            f"name: expected a CasADi name (a letter, then letters, digits, _), got {name!r}"
+        )
+    check_scene(scene, "any", name="scene")
+    if not callable(getattr(model, "distance_and_grad", None)):
+        raise InputError(f"model: expected a distance model (gdnplan.models), got {model!r}")
+    if callable(getattr(model, "check_scene", None)):
+        model.check_scene(scene)
+    check_int(n_points, "n_points", 1, MAX_POINTS)
+    if not isinstance(per_link, (bool, np.bool_)):
+        raise InputError(f"per_link: expected True or False, got {per_link!r}")
+    if not is_number(cap) or not cap > 0:
+        raise InputError(f"cap: expected a number > 0 (m) or inf, got {cap!r}")
+
+
 class DistanceCallback(casadi.Callback):
     """CasADi function x (K·dof,) -> distances (K·R,), one batched model call per new x.
 
@@ -129,6 +156,7 @@ class DistanceCallback(casadi.Callback):
         per_link: bool = False,
         cap: float = np.inf,
     ):
+        check_callback(name, model, scene, n_points, per_link, cap)
         casadi.Callback.__init__(self)
         self.n_points, self.dof = int(n_points), scene.robot.dof
         self.fn, self.rows = distance_rows(model, scene, per_link, cap)
@@ -167,7 +195,12 @@ class DistanceCallback(casadi.Callback):
                 f"(configurations × dof), got {x.size}"
             )
         c = self._cache
-        if c.x is None or not np.array_equal(c.x, x):
+        if not np.all(np.isfinite(x)):  # Ipopt's trial point went bad: NaN, and it backtracks
+            nan = np.full(self.n_points * self.rows, np.nan)
+            grad = np.full((self.n_points, self.rows, self.dof), np.nan)
+            self._cache = _Cache(x.copy(), nan, _given(grad))
+            return nan
+        if c.x is None or not np.array_equal(c.x, x, equal_nan=True):
             d, grad = self.fn(x.reshape(self.n_points, self.dof))
             self.model_calls += 1
             self._cache = c = _Cache(x.copy(), d.ravel(), grad)
