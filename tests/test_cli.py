@@ -445,3 +445,32 @@ def test_training_never_replaces_shipped_weights_unless_asked(
     with pytest.raises(SystemExit) as exit_:
         run(["train", "--env", "a", "--model", model, "--replace-shipped"])
     assert exit_.value.code == 0 and captured_training["kind"] == model
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["reproduce", "table1", "--fast", "--envs", "aa"], "--envs: 'a' is given twice"),
+        (["reproduce", "ablation", "--fast", "--envs", "b,b"], "--envs: 'b' is given twice"),
+        (["reproduce", "table1", "--fast", "--weights", "/nonexistent"], "--weights: /nonexistent"),
+        (["evaluate", "--env", "a", "--model", "coal", "--n", "5", "--n-grad", "6"], "--n-grad: 6"),
+    ],
+)
+def test_reproduce_and_evaluate_refuse_repeats_missing_weights_and_too_many_grad_samples(
+    args, message, tmp_path, capsys
+):
+    from gdnplan.cli import run
+
+    with pytest.raises(SystemExit) as exit_:
+        run([*args, *(["--out", str(tmp_path / "t.md")] if "reproduce" in args else [])])
+    assert exit_.value.code == 2 and message in capsys.readouterr().err
+
+
+def test_evaluate_prints_na_not_nan_for_an_undefined_auc(capsys):
+    from gdnplan.cli import run
+
+    with pytest.raises(SystemExit) as exit_:
+        run(["evaluate", "--env", "a", "--model", "coal", "--n", "1", "--n-grad", "1"])
+    out = capsys.readouterr().out
+    assert exit_.value.code == 0 and "nan" not in out.lower(), out
+    assert "AUC N/A (one class among 1 samples)" in out and "± N/A (one sample)" in out

@@ -3,6 +3,7 @@ tables and Figure 5."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -56,12 +57,31 @@ def evaluate_command(
         chosen = loader(env)
         if chosen is None:
             raise InputError(f"--model: no {model} weights for env {env} in weights/")
+    if n_grad > n:
+        raise InputError(
+            f"--n-grad: {n_grad} is more than --n {n} (the ACD uses the first of them)"
+        )
     r = ev.evaluate_model(chosen, env, n, n_grad)
     mae = "N/A" if r.mae is None else f"{r.mae:.4f} m ({r.mae_reach:.4f} of reach)"
-    acd = "N/A" if r.acd is None else f"{r.acd:.4f} ± {r.acd_se:.4f} over {r.n_grad}"
+    acd = "N/A" if r.acd is None else f"{r.acd:.4f} ± {_se(r.acd_se)} over {r.n_grad}"
+    auc = f"{r.auc:.4f}" if math.isfinite(r.auc) else f"N/A (one class among {r.n} samples)"
     typer.echo(
-        f"{model} env {env}: n={r.n} time {r.seconds:.4f} s, MAE {mae}, AUC {r.auc:.4f}, ACD {acd}"
+        f"{model} env {env}: n={r.n} time {r.seconds:.4f} s, MAE {mae}, AUC {auc}, ACD {acd}"
     )
+
+
+def _se(value: float) -> str:
+    """A standard error as printed: N/A where one sample leaves it undefined (NaN)."""
+    return f"{value:.4f}" if math.isfinite(value) else "N/A (one sample)"
+
+
+def no_repeats(items, flag: str) -> tuple:
+    """``items`` as a tuple, InputError naming ``flag`` when one is given twice (a run would
+    do it twice and print it twice)."""
+    seen = [x for i, x in enumerate(items) if x in items[:i]]
+    if seen:
+        raise InputError(f"{flag}: {seen[0]!r} is given twice")
+    return tuple(items)
 
 
 @reproduce_app.command("table1")
@@ -82,11 +102,16 @@ def table1_command(
     check_output_path(out, (".md",), "--out")
     if figures is not None:
         check_output_dir(figures, "--figures")
+    if weights is not None and not weights.is_dir():
+        raise InputError(f"--weights: {weights} is not a directory of weights")
     weights = weights or ev.WEIGHTS_DIR
     if not envs or any(e not in ev.ENVS for e in envs):
         raise InputError(f"--envs: expected letters from 'abcde', got {envs!r}")
     results, missing, used = ev.table1(
-        tuple(envs), fast, log=lambda m: typer.echo(m, err=True), weights_dir=weights
+        no_repeats(tuple(envs), "--envs"),
+        fast,
+        log=lambda m: typer.echo(m, err=True),
+        weights_dir=weights,
     )
     cpu = platform.processor() or platform.machine()
     header = [
@@ -223,7 +248,7 @@ def ablation_command(
     check_output_path(out, (".md",), "--out")
     if figure is not None:
         check_output_path(figure, FIGURE_SUFFIXES, "--figure")
-    chosen = tuple(e.strip() for e in envs.split(",") if e.strip())
+    chosen = no_repeats(tuple(e.strip() for e in envs.split(",") if e.strip()), "--envs")
     if not chosen or any(e not in ablation.BEST for e in chosen):
         raise InputError(f"--envs: expected some of {sorted(ablation.BEST)}, got {envs!r}")
     if train_for is not None and not 0 <= train_for < float("inf"):
