@@ -16,6 +16,7 @@ from ...errors import InputError
 from ...graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
 from ...scene import Scene, check_scene
 from ..checks import check_fits
+from ..settings import check_chunk, check_device, check_dtype, check_flag, placed
 from ..threads import check_threads, torch_threads
 from . import fused as fused_kernel
 from . import fused_net
@@ -64,14 +65,14 @@ class GraphDistNetModel:
         threads: int | None = None,
         fused: bool | None = None,
     ):
-        self.net = net.to(device, dtype).eval()
+        self.dtype = check_dtype(dtype)
+        self.device = check_device(device)
+        self.chunk = check_chunk(chunk)
+        self.net = placed(net, self.device, self.dtype)
         self.threads = check_threads(threads)
         self.config = net.config
         self.card = card or {}
-        self.chunk = chunk
-        self.dtype = dtype
-        self.device = torch.device(device)
-        self.fused = self._check_fused(fused)
+        self.fused = self._check_fused(check_flag(fused, "fused", optional=True))
         self._scenes: weakref.WeakKeyDictionary[Scene, _SceneCache] = weakref.WeakKeyDictionary()
 
     def _check_fused(self, fused: bool | None) -> bool:

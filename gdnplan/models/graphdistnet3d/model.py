@@ -36,7 +36,9 @@ from ...graph3d import (
     robot_graph3d,
     scene_graph3d,
 )
+from ...limits import check_int
 from ...scene import check_scene
+from ..settings import MAX_CHUNK, check_dtype, check_flag, placed
 from ..threads import check_threads, torch_threads
 from . import fused3d
 from .fit import check_fits3d
@@ -134,15 +136,15 @@ class GraphDistNet3DModel:
         fused: bool | None = None,
         contact_offset: float = 0.0,
     ):
-        self.net = net.to(dtype=dtype).eval()
+        self.dtype = check_dtype(dtype)
+        self.net = placed(net, torch.device("cpu"), self.dtype)
         self.contact_offset = check_offset(contact_offset)
         self.config = net.config
         self.card = card or {}
-        self.self_collision = self_collision
-        self.chunk = chunk
-        self.dtype = dtype
+        self.self_collision = check_flag(self_collision, "self_collision")
+        self.chunk = check_int(chunk, "chunk", 1, MAX_CHUNK)
         self.threads = check_threads(threads)
-        self.fused = self._check_fused(fused)
+        self.fused = self._check_fused(check_flag(fused, "fused", optional=True))
         self._scenes: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
     def with_contact_offset(self, contact_offset: float) -> GraphDistNet3DModel:

@@ -1,0 +1,70 @@
+"""Checks of a learned model's run settings (dtype, device, chunk, on/off flags), each an
+:class:`~gdnplan.errors.InputError` naming the setting, and :func:`placed`: the network on the
+requested device and dtype without changing the one the caller passed."""
+
+from __future__ import annotations
+
+import copy
+
+import torch
+
+from ..errors import InputError
+from ..limits import check_int
+
+DTYPES = (torch.float32, torch.float64)  # the passes run these (float16 overflows in 3-D)
+MAX_CHUNK = 10**6  # configurations of one inference pass
+
+
+def check_dtype(dtype) -> torch.dtype:
+    """``dtype`` when it is torch.float32 or torch.float64, else InputError."""
+    if dtype not in DTYPES:
+        raise InputError(f"dtype: expected torch.float32 or torch.float64, got {dtype!r}")
+    return dtype
+
+
+def check_device(device) -> torch.device:
+    """A CPU device, or a CUDA one where CUDA is available, else InputError."""
+    try:
+        parsed = torch.device(device)
+    except (RuntimeError, TypeError) as e:
+        raise InputError(f"device: expected 'cpu' or 'cuda', got {device!r}") from e
+    if parsed.type == "cuda" and not torch.cuda.is_available():
+        raise InputError("device: CUDA is not available on this machine; use 'cpu'")
+    if parsed.type not in ("cpu", "cuda"):
+        raise InputError(f"device: expected 'cpu' or 'cuda', got {device!r}")
+    return parsed
+
+
+def check_chunk(chunk) -> int | None:
+    """None (one pass) or an integer in 1 … :data:`MAX_CHUNK`, else InputError."""
+    return None if chunk is None else check_int(chunk, "chunk", 1, MAX_CHUNK)
+
+
+def check_flag(value, name: str, optional: bool = False) -> bool | None:
+    """True or False (or None when ``optional``), else InputError naming ``name``: "yes" or
+    1 are no settings."""
+    if value is None and optional:
+        return None
+    if not isinstance(value, bool):
+        allowed = "True, False or None" if optional else "True or False"
+        raise InputError(f"{name}: expected {allowed}, got {value!r}")
+    return value
+
+
+def placed(net: torch.nn.Module, device: torch.device, dtype: torch.dtype) -> torch.nn.Module:
+    """``net`` in eval mode on ``device`` and ``dtype``: itself when it is there already, else
+    a copy (``Module.to`` works in place: the caller's network, used elsewhere, would change)."""
+    params = list(net.parameters())
+    there = all(p.dtype == dtype and p.device == device for p in params)
+    return (net if there else copy.deepcopy(net).to(device, dtype)).eval()
+
+
+__all__ = [
+    "DTYPES",
+    "MAX_CHUNK",
+    "check_chunk",
+    "check_device",
+    "check_dtype",
+    "check_flag",
+    "placed",
+]
