@@ -32,6 +32,13 @@ class BatchedGraphDistNet:
     is_distance = True
 
     def __init__(self, model, draws: int = 1):
+        from .models.graphdistnet import GraphDistNetModel
+
+        if not isinstance(model, GraphDistNetModel):
+            raise InputError(
+                f"model: expected a planar GraphDistNet (gdnplan.models.graphdistnet), got "
+                f"{type(model).__name__}"
+            )
         draws = check_int(draws, "draws", 1, MAX_DRAWS)
         if draws > 1 and model.config.cross != "argmax":
             raise InputError(

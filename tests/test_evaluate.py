@@ -175,3 +175,6 @@ def test_mean_of_draws_is_the_mean_of_single_draws():
             BatchedGraphDistNet(model, draws=bad)
     with pytest.raises(gp.InputError, match="argmax"):
         BatchedGraphDistNet(gp.load_model("b"), draws=2)
+    for other in (None, gp.CoalModel(), gp.load_model("clearancenet_d")):
+        with pytest.raises(gp.InputError, match="model: expected a planar GraphDistNet"):
+            BatchedGraphDistNet(other)
