@@ -204,7 +204,9 @@ def check_finite_epoch(entry: dict, checkpoint: Path | None) -> None:
     loss, score = entry["train_loss"], entry["val_score"]
     if math.isfinite(loss) and math.isfinite(score):
         return
-    kept = f"; {checkpoint} keeps the last finite epoch" if checkpoint is not None else ""
+    kept = ""
+    if checkpoint is not None and checkpoint.exists():
+        kept = f"; {checkpoint} keeps the last finite epoch"
     raise InputError(
         f"training diverged at epoch {entry['epoch']} (train_loss {loss}, val_score {score}): "
         f"lower the learning rate (--lr, now {entry['lr']:g}) or the loss weights (--set "
