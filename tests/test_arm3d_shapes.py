@@ -225,6 +225,8 @@ RAW_SHAPES = {
 @given(st.sampled_from(sorted(RAW_SHAPES)), SIZES, st.sampled_from(["obstacle", "held"]))
 @example("box", float("nan"), "obstacle")  # the audit's cases: never hit by any distance
 @example("sphere", -0.5, "held")
+@example("box", 501.0, "obstacle")  # a 501 m side: within the builders' 1000 m
+@example("box", 1001.0, "held")
 def test_a_raw_coal_shape_is_checked_as_the_builders_check_it(kind, size, where):
     """obstacle(shape, …) and hold(robot, shape, …) take coal shapes: one out of the builders'
     ranges (NaN, negative, zero, beyond 1000 m) is an InputError, as box(), sphere(), …
@@ -232,7 +234,7 @@ def test_a_raw_coal_shape_is_checked_as_the_builders_check_it(kind, size, where)
     from gdnplan.arm3d import load_robot3d, obstacle
     from gdnplan.arm3d.held import hold
 
-    sides = size * (2 if kind == "box" else 1)  # coal.Box takes full sides
+    sides = size  # coal.Box takes full sides; the sphere, capsule radius and cylinder length
     valid = bool(np.isfinite(sides)) and 1e-6 <= sides <= 1e3
     shape = RAW_SHAPES[kind](size)
     build = (
