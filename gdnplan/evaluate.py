@@ -1,5 +1,6 @@
 """Table I (paper §V-A): time, MAE with Welch's t-test, ROC AUC and ACD of every method on
-every environment, the paper's figures beside them, and Fig. 5.
+every environment, the paper's figures beside them (Fig. 5 and the ROC/scatter plots:
+:mod:`gdnplan.paper_figures`, re-exported here).
 
 The metrics and one model's scores on the held-out test split (:func:`evaluate_model`,
 ``data/<env>/test``, seed 1, the same configurations and obstacle sets for every method) are
@@ -9,7 +10,6 @@ The metrics and one model's scores on the held-out test split (:func:`evaluate_m
 from __future__ import annotations
 
 import logging
-import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -19,28 +19,32 @@ from .assets import WEIGHTS_DIR
 from .data import Dataset
 from .distance import signed_distance_and_grad
 from .env_models import BatchedGraphDistNet as BatchedGraphDistNet
-from .env_models import clearancenet_of_env, graphdistnet_of_env
+from .env_models import clearancenet_of_env
+from .env_models import graphdistnet_of_env as graphdistnet_of_env
 from .env_models import load_clearancenet as load_clearancenet  # deprecated names
 from .env_models import load_graphdistnet as load_graphdistnet
+from .metrics import DEFAULT_MARGIN as DEFAULT_MARGIN
+from .metrics import DatasetModel as DatasetModel
 from .metrics import (  # moved to gdnplan.metrics; the `x as x` names are re-exported
-    DEFAULT_MARGIN,
     Result,
     coal_predict,
     evaluate_model,
     evaluate_predictions,
     predict,
-    roc_curve,
     sha256_prefix,
     test_set,
     timed,
     welch_p_value,
 )
-from .metrics import DatasetModel as DatasetModel
 from .metrics import cosine_distances as cosine_distances
 from .metrics import mean_absolute_error as mean_absolute_error
 from .metrics import roc_auc as roc_auc
+from .metrics import roc_curve as roc_curve
 from .metrics import scene_groups as scene_groups
 from .metrics import used_cosine_distances as used_cosine_distances
+from .paper_figures import detour_path as detour_path  # moved; re-exported
+from .paper_figures import fig5 as fig5
+from .paper_figures import table1_figures as table1_figures
 
 log = logging.getLogger(__name__)
 
@@ -419,80 +423,3 @@ def table1(
         if not (Path(weights_dir) / file.format(env=env)).exists()
     ]
     return out, missing, used
-
-
-def detour_path(
-    scene,
-    start: np.ndarray,
-    goal: np.ndarray,
-    clearance: float = 0.05,
-    steps: int = 200,
-    waypoints: int = 60,
-) -> np.ndarray:
-    """A joint path (T, dof) from start to goal pushed out of collision along coal's gradient.
-
-    Starts from the straight line and moves every waypoint closer than ``clearance`` (m) by
-    0.05 rad along ∂f/∂q, then re-spaces the path evenly, ``steps`` times (for Fig. 5 only).
-    """
-    q = np.linspace(start, goal, waypoints)
-    for _ in range(steps):
-        d, g = signed_distance_and_grad(scene, q[1:-1])
-        push = (d < clearance)[:, None] * g / np.maximum(np.linalg.norm(g, axis=1), 1e-9)[:, None]
-        q[1:-1] += 0.05 * push
-        arc = np.r_[0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
-        t = np.linspace(0, arc[-1], waypoints)
-        q = np.stack([np.interp(t, arc, q[:, j]) for j in range(q.shape[1])], 1)
-    return q
-
-
-def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000, progress: bool = False):
-    """The paper's Fig. 5 for a 2-DoF environment: coal, DiffCo (score) and GraphDistNet fields.
-
-    Returns the matplotlib Figure; GraphDistNet is left out when its weights are missing. With
-    ``progress`` a tqdm bar on stderr counts the grid configurations evaluated.
-    """
-    from tqdm import tqdm
-
-    from .models import CoalModel
-    from .models.diffco import DiffCo
-    from .scene import make_scene
-    from .viz import distance_field, field_figure
-
-    scene = make_scene(env, seed=0)
-    models = {"coal f (m)": CoalModel()}
-    t0 = time.perf_counter()
-    models["DiffCo score −s"] = DiffCo.train(scene, n=diffco_train)
-    log.info("field: DiffCo trained on %d samples, %.2f s", diffco_train, time.perf_counter() - t0)
-    gdn = graphdistnet_of_env(env)
-    if gdn is not None:
-        models["GraphDistNet d̂ (m)"] = gdn
-    total = len(models) * grid * grid
-    with tqdm(total=total, desc=f"field {env}", unit="q", disable=not progress) as bar:
-        fields = {
-            name: distance_field(model, scene, grid, progress=bar.update)
-            for name, model in models.items()
-        }
-    path = detour_path(scene, np.array([1.3, 1.5]), np.array([1.3, -2.6]))
-    return field_figure(scene, fields, path)
-
-
-def table1_figures(results: dict[str, tuple[list[Result], float | None]], out_dir: Path) -> list:
-    """ROC curves and predicted-vs-true scatter plots of a Table I run, written as PNGs."""
-    from .viz import roc_figure, save_figure, scatter_figure
-
-    curves, points = {}, {}
-    for env, (rows, _) in results.items():
-        truth = next(r.score for r in rows if r.method == "coal")
-        curves[env] = {
-            r.method: (*roc_curve(-r.score, truth <= DEFAULT_MARGIN), r.auc)
-            for r in rows
-            if r.method != "coal" and "w/ AL" not in r.method and r.score is not None
-        }
-        points[env] = {
-            r.method: (truth[:1000], r.score[:1000]) for r in rows if r.abs_error is not None
-        }
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths = [out_dir / "table1_roc.png", out_dir / "table1_scatter.png"]
-    save_figure(roc_figure(curves), paths[0])
-    save_figure(scatter_figure(points), paths[1])
-    return paths

@@ -104,6 +104,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
         (
             "env_models",
             "evaluate",
+            "paper_figures",
             "table2",
             "ablation",
             "fetch",
