@@ -105,6 +105,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "env_models",
             "evaluate",
             "paper_figures",
+            "table1_rows",
+            "table1_text",
             "table2",
             "ablation",
             "fetch",
