@@ -474,3 +474,13 @@ def test_evaluate_prints_na_not_nan_for_an_undefined_auc(capsys):
     out = capsys.readouterr().out
     assert exit_.value.code == 0 and "nan" not in out.lower(), out
     assert "AUC N/A (one class among 1 samples)" in out and "± N/A (one sample)" in out
+
+
+def test_reproduce_faithful_replaces_shipped_weights_only_when_asked(capsys, tmp_path):
+    """Its default --out is the shipped <env>_faithful file (its reproduction command)."""
+    from gdnplan.cli import run
+
+    with pytest.raises(SystemExit) as exit_:
+        run(["reproduce", "faithful", "--env", "d", "--data", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and "d_faithful" in err and "--replace-shipped" in err, err

@@ -152,3 +152,20 @@ def check_limits(robot, q: np.ndarray, name: str) -> np.ndarray:
             f"[{robot.lower[j]:.4g}, {robot.upper[j]:.4g}] of {robot.name}"
         )
     return q
+
+
+def check_not_shipped(target: Path, replace: bool) -> None:
+    """InputError when ``target`` (the weights to write) is an existing shipped weights file
+    (``gdnplan.assets.WEIGHTS_DIR``; from the repository root ``weights/`` is that folder)
+    and ``replace`` is off: a training run would silently change what every plan by that
+    name uses and what the README's figures were measured with."""
+    from ..assets import WEIGHTS_DIR
+
+    resolved = target.resolve()
+    shipped = WEIGHTS_DIR.resolve()
+    pair = (resolved, resolved.with_suffix(".json"))
+    if not replace and resolved.parent == shipped and any(p.exists() for p in pair):
+        raise InputError(
+            f"--out: {target} is a shipped weights file ({resolved.stem}); give another --out "
+            "(e.g. my_weights.safetensors) or --replace-shipped to replace it"
+        )

@@ -16,7 +16,7 @@ if TYPE_CHECKING:  # the commands import numpy and the library when they run: a 
     pass
 
 from .app import app
-from .common import QUIET_HELP, THREADS_HELP, set_threads, show_progress
+from .common import QUIET_HELP, THREADS_HELP, check_not_shipped, set_threads, show_progress
 
 reproduce_app = typer.Typer(
     help="Reproduce the paper's tables.", no_args_is_help=True, rich_markup_mode=None
@@ -296,8 +296,14 @@ def faithful_command(
     env: str = typer.Option(..., help="Environment a-e (its data must exist, as for train)."),
     data: Path = typer.Option(None, help="Data root (default data/)."),
     budget: float = typer.Option(None, help="Training seconds (default: the shipped weights')."),
-    out: Path = typer.Option(None, help="Weights (default weights/<env>_faithful.safetensors)."),
+    out: Path = typer.Option(
+        None,
+        help="Weights (default: the shipped <env>_faithful.safetensors; needs --replace-shipped).",
+    ),
     threads: int = typer.Option(1, help=THREADS_HELP),
+    replace_shipped: bool = typer.Option(
+        False, "--replace-shipped", help="Allow the weights to replace the shipped file."
+    ),
 ) -> None:
     """Train the paper's GraphDistNet (§IV) for Table I on the data and time budget of the
     environment's shipped weights; rerun the same command to resume (runs/faithful/<env>)."""
@@ -310,6 +316,7 @@ def faithful_command(
     if budget is not None and not budget > 0:
         raise InputError(f"--budget: expected a positive number of seconds, got {budget}")
     out = out or WEIGHTS_DIR / f"{env}_faithful.safetensors"
+    check_not_shipped(out, replace_shipped)
     check_output_path(out, (".safetensors",), "--out")
     set_threads(threads, torch_global=True)
     config = ablation.faithful_config(env, data or Path("data"), budget)

@@ -15,7 +15,7 @@ if TYPE_CHECKING:  # the commands import numpy and the library when they run: a 
     pass
 
 from .app import app
-from .common import set_threads
+from .common import check_not_shipped, set_threads
 
 
 @app.command("generate")
@@ -172,23 +172,6 @@ def train_command(
         run_dir=run_dir,
     )  # fmt: skip
     typer.echo(json.dumps({"env": env, "name": card["name"], **card["test"]}, indent=2))
-
-
-def check_not_shipped(target: Path, replace: bool) -> None:
-    """InputError when ``target`` (the weights to write) is an existing shipped weights file
-    (``gdnplan.assets.WEIGHTS_DIR``; from the repository root ``weights/`` is that folder)
-    and ``replace`` is off: a training run would silently change what every plan by that
-    name uses and what the README's figures were measured with."""
-    from ..assets import WEIGHTS_DIR
-
-    resolved = target.resolve()
-    shipped = WEIGHTS_DIR.resolve()
-    pair = (resolved, resolved.with_suffix(".json"))
-    if not replace and resolved.parent == shipped and any(p.exists() for p in pair):
-        raise InputError(
-            f"--out: {target} is a shipped weights file ({resolved.stem}); give another --out "
-            "(e.g. my_weights.safetensors) or --replace-shipped to replace it"
-        )
 
 
 def _check_model(model: str, graphdistnet_only: tuple) -> None:
