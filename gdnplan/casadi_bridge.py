@@ -200,7 +200,7 @@ class DistanceCallback(casadi.Callback):
             grad = np.full((self.n_points, self.rows, self.dof), np.nan)
             self._cache = _Cache(x.copy(), nan, _given(grad))
             return nan
-        if c.x is None or not np.array_equal(c.x, x, equal_nan=True):
+        if c.x is None or not np.array_equal(c.x, x):
             d, grad = self.fn(x.reshape(self.n_points, self.dof))
             self.model_calls += 1
             self._cache = c = _Cache(x.copy(), d.ravel(), grad)

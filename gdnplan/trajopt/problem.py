@@ -180,6 +180,7 @@ class Problem:
         named = [("start.q", self.start)] + (
             [("goal.q", self.goal)] if self.goal is not None else []
         )
+        swept = swept_radius_of(self.scene)
         for name, q in named:
             j = first_outside(q, self.lower, self.upper)
             if j is not None:
@@ -188,7 +189,6 @@ class Problem:
                     f"[{self.lower[j]:.4g}, {self.upper[j]:.4g}]"
                 )
             d = float(exact_distance(self.scene, q, margin=self.margin)[0])
-            swept = swept_radius_of(self.scene)
             if d <= self.margin or proven_distance(d, swept) <= self.certified_clearance:
                 raise InfeasibleProblemError(
                     f"{name} is in collision: distance {d:.4f} m ≤ margin {self.margin} m between "
