@@ -153,3 +153,17 @@ def test_bad_inputs_raise_input_error():
 def test_rings_handles_all_empty_rows():
     nodes, _, _, mask = rings(np.zeros((2, 1, 3, 2)), np.zeros((2, 1, 3), bool))
     assert nodes.shape == (2, 1, 2) and not mask.any()
+
+
+def test_graph_reexports_the_concept_modules_names():
+    """gdnplan.graph keeps every name it had: the same objects as the concept modules'."""
+    import gdnplan.graph as graph
+    from gdnplan import graph_batch, graph_obstacles, graph_robot
+
+    for module in (graph_batch, graph_obstacles, graph_robot):
+        for name in module.__all__:
+            assert getattr(graph, name) is getattr(module, name), name
+    assert set(graph.__all__) == {
+        n for m in (graph_batch, graph_obstacles, graph_robot) for n in m.__all__
+    }
+    assert graph._rotate is graph_robot._rotate

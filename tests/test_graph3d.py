@@ -190,3 +190,15 @@ def test_octree_obstacles_are_the_knn_graph_of_their_voxels(ur5e):
     shifted = pts + np.array([0.5, 0.0, 0.3])
     near = np.linalg.norm(centres[:, None] - shifted[None], axis=-1).min(1)
     assert near.max() <= 0.02 * np.sqrt(3) / 2 + 1e-9
+
+
+def test_graph3d_reexports_the_concept_modules_names():
+    """gdnplan.graph3d keeps every name it had: the same objects as the concept modules'."""
+    import gdnplan.graph3d as graph3d
+    from gdnplan import graph3d_obstacles, graph3d_robot, graph3d_shapes
+
+    modules = (graph3d_shapes, graph3d_robot, graph3d_obstacles)
+    for module in modules:
+        for name in module.__all__:
+            assert getattr(graph3d, name) is getattr(module, name), name
+    assert set(graph3d.__all__) == {n for m in modules for n in m.__all__}

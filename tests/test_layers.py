@@ -83,7 +83,19 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ompl_planner",
         ),
     ),
-    ("graphs", ("graph", "graph3d")),
+    (
+        "graphs",
+        (
+            "graph",  # re-exports the three below
+            "graph_batch",  # padded batches of ring graphs
+            "graph_obstacles",
+            "graph_robot",
+            "graph3d",  # re-exports the three below
+            "graph3d_shapes",  # shapes -> nodes, polytope and kNN edges, neighbourhoods
+            "graph3d_robot",
+            "graph3d_obstacles",
+        ),
+    ),
     ("models", ("models", "models.*")),
     ("casadi bridge", ("casadi_bridge",)),
     (

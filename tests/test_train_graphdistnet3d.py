@@ -148,3 +148,13 @@ def test_init_refuses_weights_that_do_not_fit(tmp_path):
         init_from_weights(GraphDistNet3D(network_config().with_(layers=3)), path)
     with pytest.raises(InputError, match="scale"):
         init_from_weights(GraphDistNet3D(network_config().with_(layers=2, scale=2.0)), path)
+
+
+def test_graphdistnet3d_reexports_the_concept_modules_names():
+    """gdnplan.train.graphdistnet3d keeps every name it had (streaming, batches, report)."""
+    from gdnplan.train import batch3d, graphdistnet3d, report3d, shard_stream3d
+
+    for module in (shard_stream3d, batch3d, report3d):
+        for name in module.__all__:
+            assert getattr(graphdistnet3d, name) is getattr(module, name), name
+            assert name in graphdistnet3d.__all__

@@ -42,7 +42,7 @@ class _Part:
 
 class StorageBatch3D:
     """Model inputs of some rows of a ``ur5e_storage`` shard (float32 tensors), the interface
-    of :class:`gdnplan.train.graphdistnet3d.Batch3D` (whose ``graph`` argument it ignores)."""
+    of :class:`gdnplan.train.batch3d.Batch3D` (whose ``graph`` argument it ignores)."""
 
     def __init__(self, rim: int, shard: dict, rows: np.ndarray):
         rows = np.asarray(rows)

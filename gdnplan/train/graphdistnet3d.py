@@ -1,13 +1,9 @@
 """Training GraphDistNet-3D on shards it streams (:func:`train3d`), resumable from a checkpoint.
 
-The training split is a folder of shards (:mod:`gdnplan.data.shards3d`); only one shard is in
-memory at a time. Epoch e visits the shards in a permutation seeded by (seed, e) and the rows of
-each shard in a permutation seeded by (seed, e, shard), in batches of ``batch`` rows (a shard's
-last, shorter batch included). A batch's robot nodes and node Jacobians come from Pinocchio
-(:meth:`~gdnplan.graph3d.RobotGraph3D.positions_and_jacobians`); the obstacle features are
-computed once per scene of the batch (one-way cross edges) and handed to its rows. A
-``ur5e_storage`` shard's rows have a robot graph each (fingers open or holding the stick:
-:mod:`gdnplan.train.batch_storage3d`); the exported card names the validation split's env.
+The training split is a folder of shards (:mod:`gdnplan.data.shards3d`) streamed one at a time,
+each epoch in a seeded order of shards and rows. A batch's robot nodes and node Jacobians come
+from Pinocchio, its obstacle features once per scene of the batch; a ``ur5e_storage`` shard's
+rows have a robot graph each. The exported card names the validation split's env.
 
 Loss: :mod:`gdnplan.train.loss` (normalised squared error, contact weight, gradient cosine).
 After every ``validate_every`` steps the network is scored on the first ``n_val`` samples of
@@ -25,6 +21,11 @@ start so that d̂ is the initial network's.
     python -m gdnplan.train.graphdistnet3d --train data/ur5e_boxes/train \\
         --val data/ur5e_boxes/test --run-dir runs/ur5e_boxes-3d [--time-budget S] \\
         [--init weights/ur5e_boxes3d_preliminary.safetensors] [--lr 3e-4] [--min-readout]
+
+Modules: the shards' files, arrays and an epoch's batches in :mod:`.shard_stream3d`, a batch's
+model inputs in :mod:`.batch3d`, the metrics on a split and the exported weights in
+:mod:`.report3d`; this module runs the training loop and the command line, and re-exports
+their names.
 """
 
 from __future__ import annotations
@@ -36,30 +37,25 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-import numpy as np
 import torch
 
 from ..arm3d.scene3d import workspace_radius
 from ..data.samples3d import env_robot3d
 from ..errors import InputError
-from ..graph3d import point_cloud_graph, robot_graph3d
+from ..graph3d import robot_graph3d
 from ..models.graphdistnet3d import (
     GraphDistNet3D,
     GraphDistNet3DConfig,
-    boxes_input,
-    forward_with_grad,
     init_from_weights,
-    obstacle_input,
     read_graphdistnet3d,
-    robot_tensors,
 )
-from ..models.weights import read_card, write_weights
-from .batch_storage3d import StorageBatch3D
+from ..models.weights import read_card
+from .batch3d import CLOUD_K, Batch3D, make_batch
 from .checkpoint import load_checkpoint, save_checkpoint
 from .loss import GraphDistNetLoss, distance_loss, gradient_loss
-from .report import git_sha, metrics
+from .report3d import evaluate3d, export_weights
+from .shard_stream3d import batches, read_shard, shard_files, split_env
 
-CLOUD_K = 6  # neighbours of a point in a cloud's graph
 PLATEAU = 20  # validations without a better MAE before the learning rate is halved
 
 
@@ -76,106 +72,6 @@ class Train3DConfig:
     grad_weight: float = 0.1
     contact_weight: float = 2.0
     contact_scale: float = 0.02
-
-
-def shard_files(folder: Path | str) -> list[Path]:
-    files = sorted(p for p in Path(folder).glob("shard_*.npz") if not p.name.endswith(".tmp.npz"))
-    if not files:
-        raise InputError(f"data: no shards in {folder}; run `gdnplan generate --env ur5e_boxes`")
-    return files
-
-
-def read_shard(path: Path) -> dict:
-    with np.load(path) as z:
-        return {k: z[k] for k in z.files}
-
-
-def batches(files: list[Path], batch: int, seed: int, epoch: int, skip: int = 0):
-    """(step, shard arrays, rows) of one epoch (module docstring), from step ``skip`` on."""
-    order = np.random.default_rng([seed, epoch]).permutation(len(files))
-    step = 0
-    for f in order:
-        shard = None
-        n = int(np.load(files[f])["d"].shape[0]) if step + 1 <= skip else None
-        if n is not None:
-            count = -(-n // batch)
-            if step + count <= skip:
-                step += count
-                continue
-        shard = read_shard(files[f])
-        perm = np.random.default_rng([seed, epoch, int(f)]).permutation(len(shard["d"]))
-        for s in range(0, len(perm), batch):
-            if step >= skip:
-                yield step, shard, perm[s : s + batch]
-            step += 1
-
-
-class Batch3D:
-    """Model inputs of some rows of a shard (float32 tensors)."""
-
-    def __init__(self, graph, shard: dict, rows: np.ndarray):
-        q = shard["q"][rows]
-        nodes, jac = graph.positions_and_jacobians(q)
-        scenes, inverse = np.unique(shard["scene"][rows], return_inverse=True)
-        self.nodes = torch.as_tensor(nodes, dtype=torch.float32)
-        self.jac = torch.as_tensor(jac, dtype=torch.float32)
-        if "points" in shard:  # ur5e_cloud: the kNN graph of every scene's cloud
-            graphs = [point_cloud_graph(shard["points"][s], CLOUD_K) for s in scenes]
-            self.obstacles = obstacle_input(graphs)
-        else:
-            self.obstacles = boxes_input(shard["box_center"][scenes], shard["box_size"][scenes])
-        self.scene_rows = torch.as_tensor(inverse.reshape(-1), dtype=torch.long)
-        self.d = torch.as_tensor(shard["d"][rows], dtype=torch.float32)
-        self.grad = torch.as_tensor(shard["grad"][rows], dtype=torch.float32)
-
-    def run(self, net: GraphDistNet3D, graph, create_graph: bool):
-        """d̂ (B,) and ∂d̂/∂q (B, dof); ``create_graph`` to train on the gradient."""
-        feats = net.obstacle_pass(self.obstacles).take(self.scene_rows)
-        return forward_with_grad(net, graph, self.nodes, self.jac, feats, create_graph)
-
-    def distance(self, net: GraphDistNet3D, graph) -> torch.Tensor:
-        """d̂ (B,) alone (training on the distance loss only: no double backward)."""
-        feats = net.obstacle_pass(self.obstacles).take(self.scene_rows)
-        nbr, nbr_mask = robot_tensors(graph)
-        return net(self.nodes, nbr, nbr_mask, feats)
-
-
-def make_batch(graph, shard: dict, rows: np.ndarray, rim: int):
-    """The batch of some rows of a shard: :class:`Batch3D` with the robot ``graph``, or for a
-    ``ur5e_storage`` shard (robot variants) a :class:`StorageBatch3D` (a robot graph per row)."""
-    if "variant" in shard:
-        return StorageBatch3D(rim, shard, rows)
-    return Batch3D(graph, shard, rows)
-
-
-def split_env(folder: Path | str) -> str:
-    """The environment of a split folder (its first shard's ``env``)."""
-    return str(read_shard(shard_files(folder)[0])["env"])
-
-
-def evaluate3d(net: GraphDistNet3D, folder: Path | str, n: int | None = None, chunk: int = 200):
-    """Metrics (:func:`gdnplan.train.report.metrics`, margin 0) of ``net`` on the first n samples
-    of a split folder, against its coal labels, with ∂d̂/∂q through the node Jacobians."""
-    net.eval()
-    graph = robot_graph3d(env_robot3d("ur5e_boxes"), net.config.rim)
-    d_hat, g_hat, d, g = [], [], [], []
-    taken = 0
-    for f in shard_files(folder):
-        shard = read_shard(f)
-        m = len(shard["d"]) if n is None else min(len(shard["d"]), n - taken)
-        for s in range(0, m, chunk):
-            b = make_batch(graph, shard, np.arange(s, min(s + chunk, m)), net.config.rim)
-            dh, gh = b.run(net, graph, False)
-            d_hat.append(dh.detach().double().numpy())
-            g_hat.append(gh.detach().double().numpy())
-            d.append(b.d.double().numpy())
-            g.append(b.grad.double().numpy())
-        taken += m
-        if n is not None and taken >= n:
-            break
-    net.train()
-    arrays = [np.concatenate(x) for x in (d_hat, g_hat, d, g)]
-    return metrics(*arrays, reach=net.config.scale, margin=0.0)
 
 
 def network_config(init: Path | str | None = None, min_readout: bool = False):
@@ -309,39 +205,6 @@ def _save(ckpt, net, opt, state, best_state) -> None:
     save_checkpoint(ckpt, net, opt, {**state, "best_state": best_state})
 
 
-def export_weights(
-    run_dir: Path | str, out: Path | str, val_dir: Path | str, n_test: int | None = None
-) -> dict:
-    """Write the run's best state as weights + card with its measured metrics on ``val_dir``."""
-    run_dir = Path(run_dir)
-    ckpt = run_dir / "checkpoint.safetensors"
-    card = read_card(ckpt, "checkpoint")
-    network = GraphDistNet3DConfig.from_dict(card["settings"]["network"])
-    net = GraphDistNet3D(network)
-    opt = torch.optim.Adam(net.parameters())
-    state = load_checkpoint(ckpt, net, opt)
-    if state.get("best_state"):
-        net.load_state_dict(state["best_state"])
-    test = evaluate3d(net, val_dir, n_test)
-    out_card = {
-        "model": "graphdistnet3d",
-        "env": split_env(val_dir),
-        "robot": "ur5e",
-        "training": {k: state[k] for k in ("epoch", "step", "samples", "seconds", "best")},
-        "settings": card["settings"],
-        "test": {"dir": str(val_dir), **test},
-        "acceptance": {
-            "auc_min": 0.99,
-            "acd_max": 0.35,
-            "met": bool(test["auc"] >= 0.99 and test["acd"] <= 0.35),
-        },
-        "git_sha": git_sha(),
-        "config": network.to_dict(),
-    }
-    write_weights(Path(out), net.state_dict(), out_card)
-    return out_card
-
-
 def main(argv: list[str] | None = None) -> None:
     p = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -375,6 +238,24 @@ def main(argv: list[str] | None = None) -> None:
     config = Train3DConfig(lr=a.lr, grad_weight=a.grad_weight, validate_every=a.validate_every)
     network = network_config(a.init, a.min_readout)
     train3d(a.train, a.val, a.run_dir, config, network, a.time_budget, init=a.init)
+
+
+__all__ = [
+    "CLOUD_K",
+    "PLATEAU",
+    "Batch3D",
+    "Train3DConfig",
+    "batches",
+    "evaluate3d",
+    "export_weights",
+    "main",
+    "make_batch",
+    "network_config",
+    "read_shard",
+    "shard_files",
+    "split_env",
+    "train3d",
+]
 
 
 if __name__ == "__main__":
