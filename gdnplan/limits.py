@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,7 @@ MAX_RRT_TIME = 600.0  # s, one RRT-Connect run
 MAX_DRAWS = 1000  # BatchedGraphDistNet draws: each is a whole pass over the samples
 MAX_TIMED_SAMPLES = 1_000_000  # TimedTrajectory.sample: time samples of one call
 
+FLOAT_MAX = sys.float_info.max  # the largest finite float; a larger int is no number (is_number)
 MAX_SEED = 2**62  # plan(seed=…): seed i of a call draws the stream seed + i
 MAX_IPOPT_NUMBER = 1e20  # Ipopt's own "no limit" default (max_cpu_time, …): larger is refused
 # (bound_push = 1e300 overflows inside Ipopt and hangs a factorisation for minutes)
@@ -102,10 +104,20 @@ IPOPT_REFUSED = {
 
 
 def is_number(value) -> bool:
-    """An int or float (numpy scalars included), not a bool."""
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+    """An int or float (numpy scalars included), not a bool, that a float holds: an int past
+    ±1.8·10³⁰⁸ (a TOML file may hold one) is no number here, since ``math.isfinite`` and numpy
+    raise OverflowError on it."""
+    if not isinstance(value, (int, float, np.integer, np.floating)) or isinstance(
         value, (bool, np.bool_)
-    )
+    ):
+        return False
+    return fits_float(value)
+
+
+def fits_float(value: object) -> bool:
+    """``value`` converts to a float without overflow (an int past ±1.8·10³⁰⁸ does not: it is
+    no number for ``math.isfinite``, numpy or torch, which raise OverflowError on it)."""
+    return not isinstance(value, int) or -FLOAT_MAX <= value <= FLOAT_MAX
 
 
 def check_number(value, name: str, low: float = 0.0, strict: bool = False) -> float:
@@ -114,7 +126,7 @@ def check_number(value, name: str, low: float = 0.0, strict: bool = False) -> fl
     ok = ok and (value > low if strict else value >= low)
     if not ok:
         relation = ">" if strict else "≥"
-        raise InputError(f"{name}: expected a finite number {relation} {low:g}, got {value!r}")
+        raise InputError(f"{name}: expected a finite number {relation} {low:g}, got {shown(value)}")
     return float(value)
 
 
@@ -125,8 +137,10 @@ def shown(value: object, limit: int = 40) -> str:
         value = value.item()
     try:
         text = repr(value)
-    except ValueError:  # an int beyond Python's digit limit for str()
-        return f"an integer of about {value.bit_length() * 0.30103:.0f} digits"
+    except ValueError:  # an int beyond Python's digit limit for str(), or a list holding one
+        if isinstance(value, int):
+            return f"an integer of about {value.bit_length() * 0.30103:.0f} digits"
+        return f"a {type(value).__name__} holding an integer too long to show"
     except RecursionError:  # lists nested deeper than repr follows
         return f"a {type(value).__name__} nested too deeply to show"
     return text if len(text) <= limit else f"{text[:limit]}…"
@@ -153,7 +167,7 @@ def check_ipopt(options) -> None:
     values of their type in their range (a bad name or value makes Ipopt stop with
     Invalid_Option and print its option help to stdout)."""
     if not isinstance(options, dict):
-        raise InputError(f"ipopt: expected a table of Ipopt options, got {options!r}")
+        raise InputError(f"ipopt: expected a table of Ipopt options, got {shown(options)}")
     for key, value in options.items():
         kind = IPOPT_OPTIONS.get(key)
         where = f"ipopt.{key}"
@@ -161,14 +175,14 @@ def check_ipopt(options) -> None:
             raise InputError(
                 f"{where}: unknown or unsupported option; allowed: {sorted(IPOPT_OPTIONS)}"
             )
-        if isinstance(kind, tuple):
-            if (key, value) in IPOPT_REFUSED:
+        if isinstance(kind, tuple):  # a string option (a list or array value is no string)
+            if isinstance(value, str) and (key, value) in IPOPT_REFUSED:
                 raise InputError(
                     f"{where}: {value!r} is not supported: {IPOPT_REFUSED[key, value]}; "
                     f"choose one of {list(kind)}"
                 )
-            if value not in kind:
-                raise InputError(f"{where}: expected one of {list(kind)}, got {value!r}")
+            if not isinstance(value, str) or value not in kind:
+                raise InputError(f"{where}: expected one of {list(kind)}, got {shown(value)}")
         else:
             check_ipopt_number(value, where, kind)
 
@@ -177,6 +191,6 @@ def check_ipopt_number(value, where: str, allowed: IpoptRange) -> None:
     """InputError naming ``where`` and the range unless ``value`` is a number (an integer for
     an integer option) in ``allowed``."""
     what = "an integer" if allowed.kind is int else "a number"
-    typed = is_integer(value) if allowed.kind is int else is_number(value)
+    typed = (is_integer(value) and fits_float(value)) if allowed.kind is int else is_number(value)
     if not typed or not math.isfinite(value) or not allowed.holds(value):
-        raise InputError(f"{where}: expected {what} in {allowed.text()}, got {value!r}")
+        raise InputError(f"{where}: expected {what} in {allowed.text()}, got {shown(value)}")

@@ -15,6 +15,7 @@ import numpy as np
 
 from .errors import InputError
 from .exact import certify, motion_bound_of
+from .limits import is_number, shown
 from .scene import Scene
 
 
@@ -117,20 +118,16 @@ def rrt_connect(
 
 def _check_settings(step, time_limit, clearance, max_iterations) -> None:
     for name, value in (("rrt_step", step), ("rrt_time", time_limit)):
-        if not _number(value) or not math.isfinite(value) or value <= 0:
-            raise InputError(f"{name}: expected a finite number > 0, got {value!r}")
-    if not _number(clearance) or not math.isfinite(clearance) or clearance < 0:
-        raise InputError(f"rrt clearance: expected a finite number ≥ 0, got {clearance!r}")
+        if not is_number(value) or not math.isfinite(value) or value <= 0:
+            raise InputError(f"{name}: expected a finite number > 0, got {shown(value)}")
+    if not is_number(clearance) or not math.isfinite(clearance) or clearance < 0:
+        raise InputError(f"rrt clearance: expected a finite number ≥ 0, got {shown(clearance)}")
     if (
         isinstance(max_iterations, bool)
         or not isinstance(max_iterations, int)
         or max_iterations < 1
     ):
         raise InputError(f"max_iterations: expected an integer ≥ 1, got {max_iterations!r}")
-
-
-def _number(value) -> bool:
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
 
 
 def _connect(

@@ -12,7 +12,7 @@ import numpy as np
 
 from .arm3d.robot3d import Robot3D
 from .errors import InputError
-from .limits import is_number
+from .limits import is_number, shown
 from .robot import Robot
 
 LIMIT_RANGE = (1e-6, 1e9)  # max_velocity (rad/s) and max_acceleration (rad/s²) allowed
@@ -24,9 +24,10 @@ def limit_vector(value, dof: int, name: str, unit: str) -> np.ndarray:
     ``unit``; beyond it a path's times or their squares leave float64), else InputError."""
     if is_number(value):
         value = [value] * dof
-    items = list(value) if isinstance(value, (list, tuple, np.ndarray)) else None
+    listed = isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.ndim == 1)
+    items = list(value) if listed else None  # a 0-d or 2-d array is neither (list() fails)
     if items is None or len(items) != dof or not all(is_number(x) for x in items):
-        raise InputError(f"{name}: expected a number or {dof} numbers ({unit}), got {value!r}")
+        raise InputError(f"{name}: expected a number or {dof} numbers ({unit}), got {shown(value)}")
     out = np.asarray(items, float)
     if not np.all(np.isfinite(out) & (out > 0)):
         raise InputError(f"{name}: expected finite limits > 0 ({unit}), got {out.tolist()}")

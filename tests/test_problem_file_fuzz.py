@@ -28,6 +28,7 @@ ANSWER_TIMEOUT = 60.0  # s: a hang guard for the subprocess, not a performance b
 
 scalars = st.one_of(
     st.integers(-(2**63), 2**63 - 1),
+    st.sampled_from([10**309, -(10**400)]),  # TOML ints past the float range (OverflowError)
     st.floats(allow_nan=True, allow_infinity=True),
     st.sampled_from([0, -1, 1, 3, 1e9, 1e300, -0.0, math.nan, math.inf, 0.02, 2.006]),
     st.text(max_size=8),

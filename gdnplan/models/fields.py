@@ -29,7 +29,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import InputError
-from ..limits import check_int, shown
+from ..limits import check_int, fits_float, shown
 
 MIN_LENGTH, MAX_LENGTH = 1e-3, 1e3  # m: scale, length, |origin| (and correction bands below)
 MAX_LAYERS = 64  # message-passing layers
@@ -41,7 +41,8 @@ MIN_TEMPERATURE, MAX_TEMPERATURE = 1e-12, 1e6  # τ, τ_m (normalised units; sto
 
 
 def _is_real(value: object) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+    """A real number a float holds (not a bool; an int past ±1.8·10³⁰⁸ overflows)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool) and fits_float(value)
 
 
 def check_real(name: str, value: object, low: float, high: float, unit: str = "") -> float:

@@ -32,7 +32,7 @@ import torch
 from tqdm import tqdm
 
 from ..errors import InputError
-from ..limits import check_int
+from ..limits import check_int, is_number, shown
 from .checkpoint import load_checkpoint, save_checkpoint
 
 CLOCKS = {"wall": time.perf_counter, "cpu": time.process_time}  # FitConfig.budget_clock
@@ -76,13 +76,13 @@ def check_schedule(c: FitConfig) -> None:
     """InputError naming the first field of ``c`` that is not usable."""
     for name, least in COUNTS.items():
         check_int(getattr(c, name), name, least)
-    if not (isinstance(c.lr, (int, float)) and math.isfinite(c.lr) and c.lr >= 0):
-        raise InputError(f"lr: expected a finite learning rate ≥ 0, got {c.lr!r}")
+    if not (is_number(c.lr) and math.isfinite(c.lr) and c.lr >= 0):
+        raise InputError(f"lr: expected a finite learning rate ≥ 0, got {shown(c.lr)}")
     budget = c.time_budget
-    if budget is not None and not (
-        isinstance(budget, (int, float)) and math.isfinite(budget) and budget > 0
-    ):
-        raise InputError(f"time_budget: expected a finite number of seconds > 0, got {budget!r}")
+    if budget is not None and not (is_number(budget) and math.isfinite(budget) and budget > 0):
+        raise InputError(
+            f"time_budget: expected a finite number of seconds > 0, got {shown(budget)}"
+        )
     if c.budget_clock not in CLOCKS:
         raise InputError(f"budget_clock: expected one of {sorted(CLOCKS)}, got {c.budget_clock!r}")
     try:

@@ -38,6 +38,7 @@ from ..limits import (
     check_int,
     check_ipopt,
     check_number,
+    shown,
 )
 
 INITIAL_GUESSES = ("auto", "straight", "rrt")
@@ -52,7 +53,7 @@ DEFAULT_SEEDS = 3
 def _check_bools(cfg, names: tuple[str, ...]) -> None:
     for name in names:
         if not isinstance(getattr(cfg, name), bool):
-            raise InputError(f"{name}: expected true or false, got {getattr(cfg, name)!r}")
+            raise InputError(f"{name}: expected true or false, got {shown(getattr(cfg, name))}")
 
 
 @dataclass(frozen=True)
@@ -94,19 +95,21 @@ class SeedConfig:
 
     def __post_init__(self) -> None:
         if self.initial not in INITIAL_GUESSES:
-            raise InputError(f"initial: unknown {self.initial!r}; choose one of {INITIAL_GUESSES}")
+            raise InputError(
+                f"initial: unknown {shown(self.initial)}; choose one of {INITIAL_GUESSES}"
+            )
         if self.count is not None:
             check_int(self.count, "count", 1, MAX_SEEDS)
         if isinstance(self.kinds, list):
             object.__setattr__(self, "kinds", tuple(self.kinds))
         if not isinstance(self.kinds, tuple) or not self.kinds:
-            raise InputError(f"kinds: expected a list of seed kind names, got {self.kinds!r}")
+            raise InputError(f"kinds: expected a list of seed kind names, got {shown(self.kinds)}")
         for kind in self.kinds:
             if isinstance(kind, str) and kind in MISSING_SEED_KINDS:
                 raise InputError(f"kinds: seed kind {kind!r} {MISSING_SEED_KINDS[kind]}")
             if not isinstance(kind, str) or kind not in SEED_KINDS:
                 raise InputError(
-                    f"kinds: unknown seed kind {kind!r}; choose from {list(SEED_KINDS)}"
+                    f"kinds: unknown seed kind {shown(kind)}; choose from {list(SEED_KINDS)}"
                 )
         check_int(self.starts, "starts", 1, MAX_STARTS)
         if self.time_budget is not None:

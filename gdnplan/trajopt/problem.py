@@ -21,7 +21,7 @@ from ..assets import problem_file
 from ..ccd import proven_distance
 from ..errors import InfeasibleProblemError, InputError, ProblemFileError
 from ..exact import closest_pair, exact_distance, swept_radius_of
-from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number
+from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number, shown
 from ..robot import first_outside
 from ..scene import Scene
 from .config import PlanConfig
@@ -150,7 +150,7 @@ class Problem:
         if not (is_number(self.clearance) and math.isfinite(self.clearance)):
             raise InputError(
                 f"options.clearance: expected a finite number in [0, margin] (m), got "
-                f"{self.clearance!r}; leave it out to certify the margin"
+                f"{shown(self.clearance)}; leave it out to certify the margin"
             )
         if not 0 <= self.clearance <= self.margin:
             raise InputError(

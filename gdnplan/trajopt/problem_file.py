@@ -21,7 +21,7 @@ from ..arm3d.scene_file3d import scene3d_from_config
 from ..assets import problem_file
 from ..errors import InputError, ProblemFileError
 from ..files import read_input
-from ..limits import IPOPT_OPTIONS, is_number
+from ..limits import IPOPT_OPTIONS, is_number, shown
 from ..scene import Scene, no_unknown_keys, scene_from_config
 from .config import CONFIG_TABLES, AdamConfig, IpoptConfig, PlanConfig, config_keys
 from .options import OLD_KEYS, REMOVED, SOLVER_KEYS
@@ -63,6 +63,8 @@ def read_problem_file(path: str | Path) -> dict:
         raise ProblemFileError(f"{path}: not UTF-8 text (byte {e.start}); save it as UTF-8") from e
     except tomllib.TOMLDecodeError as e:
         raise ProblemFileError(f"{path}: malformed TOML: {e}") from e
+    except ValueError as e:  # an integer of more digits than Python converts (sys.int_info)
+        raise ProblemFileError(f"{path}: a number too long to read ({e}); shorten it") from e
     except RecursionError as e:
         raise ProblemFileError(f"{path}: arrays or tables nest too deeply; flatten them") from e
 
@@ -94,7 +96,7 @@ def problem_tables(cfg: dict, base_dir=None, require_goal: bool = True) -> Probl
         if key not in cfg:
             raise ProblemFileError(f"[{key}]: missing table", schema=True)
         if not isinstance(cfg[key], dict):
-            raise ProblemFileError(f"[{key}]: expected a table, got {cfg[key]!r}")
+            raise ProblemFileError(f"[{key}]: expected a table, got {shown(cfg[key])}")
         _no_unknown(cfg[key], keys, f"[{key}]")
     options = cfg.get("options", {})
     if not isinstance(options, dict):
@@ -228,7 +230,7 @@ def _typed(value, default, where: str) -> None:
         names = {float: "a number", int: "an integer", bool: "true or false", dict: "a table"}
         names[tuple] = "a list"
         wanted = names.get(type(default), f"a {type(default).__name__}")
-        raise ProblemFileError(f"{where}: expected {wanted}, got {value!r}")
+        raise ProblemFileError(f"{where}: expected {wanted}, got {shown(value)}")
 
 
 _no_unknown = no_unknown_keys  # the check of every table's keys (the CLI uses it too)
@@ -238,11 +240,11 @@ def _vector(value, n: int, name: str) -> np.ndarray:
     """A finite float (n,) vector or InputError naming the field (no strings, no booleans)."""
     items = value.tolist() if isinstance(value, np.ndarray) else value
     if not isinstance(items, (list, tuple)) or not all(is_number(x) for x in items):
-        raise InputError(f"{name}: expected a list of {n} numbers, got {value!r}")
+        raise InputError(f"{name}: expected a list of {n} numbers, got {shown(value)}")
     try:
         v = np.asarray(value, dtype=float)
     except (TypeError, ValueError) as e:
-        raise InputError(f"{name}: expected {n} numbers, got {value!r}") from e
+        raise InputError(f"{name}: expected {n} numbers, got {shown(value)}") from e
     if v.shape != (n,):
         raise InputError(f"{name}: expected {n} numbers, got shape {v.shape}")
     if not np.all(np.isfinite(v)):
