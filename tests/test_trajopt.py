@@ -132,6 +132,18 @@ def test_adam_pushes_the_straight_line_out_of_the_square(square):
     assert result.status == "adam: cost below threshold" and result.iterations > 1
 
 
+@pytest.mark.parametrize(
+    "config", [AdamConfig(c=1e300, eps=5e-324), AdamConfig(lr=1e308, c=1e300)], ids=["c/ε", "lr"]
+)
+def test_adam_stops_on_a_non_finite_step(square, config):
+    """An overflowing collision cost made a NaN path, which the distance call refused as bad
+    input ("q: contains NaN") though the caller gave no q: now a failed plan of finite q."""
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=20)
+    result = plan(p, solver=config)
+    assert result.status.startswith("adam: diverged (a non-finite step; lower lr or c")
+    assert np.all(np.isfinite(result.q)) and not result.success
+
+
 class Underestimating:
     """A learned stand-in: coal's distance minus 0.25 m (rates the whole problem too close)."""
 

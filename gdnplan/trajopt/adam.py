@@ -87,7 +87,8 @@ def _plan_adam(
     points and Adam continues. The margin of each check point is that of
     :func:`distance_bounds` (relaxed next to an endpoint a learned model rates below the
     margin). It stops at ``deadline`` (a :func:`time.perf_counter` value) too; the
-    certificate judges the path it has then."""
+    certificate judges the path it has then, and after a non-finite step (an overflowing
+    cost: huge ``c`` or ``lr``, tiny ``eps``) the last finite path."""
     opts, refine = cfg.optimizer, cfg.refine
     T = problem.waypoints
     splits = np.full(T - 1, opts.interpolated + 1)
@@ -114,14 +115,18 @@ def _plan_adam(
             W, refinements = _interpolation_matrix(splits), refinements + 1
             lower = distance_bounds(problem, model, goal, splits, problem.margin, slack)
             continue
-        _, dc = collision_cost(np.asarray(d), lower, opts.c, opts.eps)
-        grad = W.T @ (dc[:, None] * g)
-        grad[1:] += 2 * (q[1:] - q[:-1])
-        grad[:-1] -= 2 * (q[1:] - q[:-1])
-        grad[[0, -1]] = 0.0
-        m = b1 * m + (1 - b1) * grad
-        v = b2 * v + (1 - b2) * grad**2
-        step = opts.lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # checked below
+            _, dc = collision_cost(np.asarray(d), lower, opts.c, opts.eps)
+            grad = W.T @ (dc[:, None] * g)
+            grad[1:] += 2 * (q[1:] - q[:-1])
+            grad[:-1] -= 2 * (q[1:] - q[:-1])
+            grad[[0, -1]] = 0.0
+            m = b1 * m + (1 - b1) * grad
+            v = b2 * v + (1 - b2) * grad**2
+            step = opts.lr * (m / (1 - b1**it)) / (np.sqrt(v / (1 - b2**it)) + 1e-8)
+        if not np.all(np.isfinite(step)):  # the cost overflowed (c/ε^1.5 or lr huge)
+            status = "adam: diverged (a non-finite step; lower lr or c, or raise eps)"
+            break  # keep the last finite path: the certificate judges it
         q = project_steps(q - step, problem.max_step, problem.lower, problem.upper)
     log.info("solve: %s, %d iterations", status, it)
     return _Run(
