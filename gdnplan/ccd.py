@@ -56,7 +56,7 @@ import numpy as np
 
 from .distance import signed_distance
 from .errors import InputError
-from .limits import check_int, check_number, is_number
+from .limits import check_int, check_number, is_number, shown
 from .robot import Robot
 from .scene import Scene, check_scene
 
@@ -143,12 +143,19 @@ class Certificate:
     reason: str = ""
 
 
-def _check_args(margin: float, tol: float, min_splits: int, max_checks: int) -> None:
+def check_certify_args(
+    margin: float, tol: float, min_splits: int, max_checks: int, stop_early: bool
+) -> None:
+    """InputError naming the first bad argument of a certificate (:func:`certify_path`,
+    :func:`gdnplan.arm3d.certify_path3d`): ``stop_early`` is True or False (not 1, not a
+    string, which would be taken as true)."""
     check_number(margin, "margin")
     if not (is_number(tol) and tol > 0) or math.isnan(tol):
-        raise InputError(f"tol: expected a number > 0 (m) or inf, got {tol!r}")
+        raise InputError(f"tol: expected a number > 0 (m) or inf, got {shown(tol)}")
     check_int(min_splits, "min_splits", 1, MAX_SPLITS)
     check_int(max_checks, "max_checks", 1, MAX_CHECKS)
+    if not isinstance(stop_early, bool):
+        raise InputError(f"stop_early: expected True or False, got {shown(stop_early)}")
 
 
 def _initial_pieces(q_path: np.ndarray, splits: int):
@@ -201,7 +208,7 @@ def certify_path(
             initial pieces alone exceed it: then ``n_checks`` is 0, module docstring).
     """
     check_scene(scene, use="gdnplan.arm3d.certify_path3d")
-    _check_args(margin, tol, min_splits, max_checks)
+    check_certify_args(margin, tol, min_splits, max_checks, stop_early)
     robot = scene.robot
     q_path = robot.check_q(q_path, "q_path")
     if not len(q_path):

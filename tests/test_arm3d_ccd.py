@@ -64,3 +64,5 @@ def test_certificate_input_errors():
         certify_path3d(scene, HOME[None])
     with pytest.raises(InputError, match="margin"):
         certify_path3d(scene, np.stack([HOME, HOME]), margin=-1.0)
+    with pytest.raises(InputError, match=r"^stop_early: expected True or False, got 'no'$"):
+        certify_path3d(scene, np.stack([HOME, HOME]), stop_early="no")

@@ -162,11 +162,14 @@ def test_a_budget_that_runs_out_is_a_failure():
         {"min_splits": 0},
         {"max_checks": 0},
         {"min_splits": 2.5},
+        {"stop_early": 1},
+        {"stop_early": "no"},
+        {"tol": 10**400},
     ],
 )
 def test_bad_certificate_arguments_are_input_errors(kwargs):
     scene = gp.make_scene("a")
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match=f"^{next(iter(kwargs))}: expected"):
         certify_path(scene, np.zeros((2, 2)), **kwargs)
 
 

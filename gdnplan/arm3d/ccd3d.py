@@ -56,9 +56,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..ccd import MAX_CHECKS, MAX_SPLITS, Certificate, certify_by_bisection
+from ..ccd import Certificate, certify_by_bisection, check_certify_args
 from ..errors import InputError
-from ..limits import check_int, check_number, is_number
 from ..scene import check_scene
 from .distance3d import checker3d
 from .robot3d import Robot3D
@@ -199,11 +198,7 @@ def certify_path3d(
     :class:`Certificate3D`.
     """
     check_scene(scene, "3d", "gdnplan.certify_path")
-    check_number(margin, "margin")
-    check_int(min_splits, "min_splits", 1, MAX_SPLITS)
-    check_int(max_checks, "max_checks", 1, MAX_CHECKS)
-    if not (is_number(tol) and tol > 0):
-        raise InputError(f"tol: expected a number > 0 (m) or inf, got {tol!r}")
+    check_certify_args(margin, tol, min_splits, max_checks, stop_early)
     robot = scene.robot
     q_path = robot.check_q(q_path, "q_path")
     if len(q_path) < 2:
@@ -216,7 +211,7 @@ def certify_path3d(
         margin,
         tol,
         min_splits,
-        bool(stop_early),
+        stop_early,
         max_checks,
         checker.swept_max,
     )
