@@ -52,6 +52,8 @@ def evaluate_command(
         from ..models.diffco import DiffCo
 
         chosen = DiffCo.train(make_scene(ev.DIFFCO_SOURCE.get(env, env)), n=3000)
+        if env not in ev.DIFFCO_OWN_SCENE:  # Table I's "DiffCo (w/o AL)": the trained layout
+            chosen = chosen.ignoring_obstacles()
     else:
         loader = ev.clearancenet_of_env if model == "clearancenet" else ev.graphdistnet_of_env
         chosen = loader(env)

@@ -1,35 +1,38 @@
 """DiffCo (Zhi, Das, Yip, "DiffCo: Auto-Differentiable Proxy Collision Detection with Multi-class
 Labels for Safety-Aware Trajectory Optimization", T-RO 2022), written from the paper's description.
 
-A kernel perceptron over configurations with the forward-kinematics kernel. Control points are
-the robot's graph nodes x(q) = robot.node_positions(q) ∈ R^{N×2}; the kernel is the rational
-quadratic kernel on them,
-
-    k(q, q') = (1 + γ/p · r²)^(−p),   r² = (1/N) Σ_n ‖x_n(q) − x_n(q')‖²   (m², p = 2),
-
-(r² averages over the N points so that γ (m⁻²) does not depend on the robot). The collision
+A kernel perceptron over configurations with the forward-kinematics kernel k(q, q') on the
+robot's graph nodes x(q) (:class:`~gdnplan.models.diffco_kernel.FKKernel`). The collision
 score is s(q) = Σ_i α_i k(q, q_i) over support points q_i; s > 0 predicts a collision. Its
 gradient uses the node Jacobians J_n(q) = ∂x_n/∂q (B, N, 2, dof):
 
-    ∂s/∂q = Σ_i α_i ∂k/∂r² · (2/N) Σ_n (x_n(q) − x_n(q_i))ᵀ J_n(q),
-    ∂k/∂r² = −γ (1 + γ/p · r²)^(−p−1).
+    ∂s/∂q = Σ_i α_i ∂k/∂r² · (2/N) Σ_n (x_n(q) − x_n(q_i))ᵀ J_n(q).
 
-Training is Fastron's perceptron (Das & Yip 2020): labels y = +1 (coal f ≤ margin) or −1,
-hypothesis F = K α; repeatedly correct the worst misclassified point i by
-Δα_i = β^{(1+y_i)/2} y_i − F_i (K_ii = 1), and drop support points whose removal keeps
-y_j (F_j − α_j) > 0, until every training point is classified correctly or the iteration budget
-ends. Active learning for a changed environment (DiffCo §IV-D / Fastron): relabel the support
-points with coal in the new scene, add Gaussian perturbations around them (exploitation) and
-uniform samples (exploration), label those with coal and continue the perceptron from the old
-weights. The fitted variant (DiffCo's smooth surrogate for optimisation) is kernel ridge
-regression of coal's signed distance over the labelled pool P (the training or active-learning
-configurations, at most ``FIT_MAX`` of them) with the same kernel: w = (K_PP + λI)⁻¹ f_P,
-f̃(q) = Σ_{j∈P} w_j k(q, q_j). Fitting only the support points, which all lie on the collision
-boundary, leaves f̃ ≈ 0 away from it and its gradient pointing the wrong way.
+Training is Fastron's perceptron (:func:`~gdnplan.models.diffco_kernel.fastron`) on labels
+y = +1 (coal f ≤ margin) or −1. Active learning for a changed environment (DiffCo §IV-D /
+Fastron): relabel the support points with coal in the new scene, add Gaussian perturbations
+around them (exploitation) and uniform samples (exploration), label those with coal and continue
+the perceptron from the old weights. The fitted variant (DiffCo's smooth surrogate for
+optimisation) is kernel ridge regression of coal's signed distance over the labelled pool P (the
+training or active-learning configurations, at most ``FIT_MAX`` of them) with the same kernel:
+w = (K_PP + λI)⁻¹ f_P, f̃(q) = Σ_{j∈P} w_j k(q, q_j). Fitting only the support points, which
+all lie on the collision boundary, leaves f̃ ≈ 0 away from it and its gradient pointing the
+wrong way.
 
 As a :class:`~gdnplan.models.DistanceModel` DiffCo returns −s (larger = freer), so AUC and ACD
-are defined but it is not a distance in metres (``is_distance = False``; MAE is N/A). DiffCo is
-tied to the environment it was trained in: ``distance`` ignores the scene's obstacles.
+are defined but it is not a distance in metres (``is_distance = False``; MAE is N/A).
+
+DiffCo is tied to the environment it was trained in: it records the obstacle layout of its
+training scene (of the scene of its last :meth:`DiffCo.adapt`), and ``distance``,
+``distance_and_grad``, ``predict_dataset`` and the CasADi callback (``check_scene``) refuse a
+scene of another robot or with other obstacles (:mod:`gdnplan.models.diffco_scene`: the same
+polygons in order, every vertex within 1e-6 m) with an InputError naming the fix. The score
+of the trained layout in a changed scene (Table I's "DiffCo w/o AL") is asked for explicitly:
+``model.ignoring_obstacles()`` is a copy that evaluates any scene of the robot. DiffCo is
+not saved to files (it trains in seconds), so no stored model lacks its layout.
+
+Modules: the kernel and Fastron in :mod:`gdnplan.models.diffco_kernel`, the robot and layout
+checks in :mod:`gdnplan.models.diffco_scene`; this module re-exports their names.
 """
 
 from __future__ import annotations
@@ -41,9 +44,20 @@ import numpy as np
 from ..distance import signed_distance
 from ..errors import InputError
 from ..limits import check_int
-from ..robot import Robot, make_rng
+from ..robot import make_rng
 from ..scene import Scene, check_scene
+from .diffco_kernel import FKKernel, fastron
+from .diffco_scene import (
+    LAYOUT_TOL,
+    dataset_difference,
+    layout_difference,
+    layout_of,
+    same_kinematics,
+    stale_layout_error,
+    unknown_layout_error,
+)
 from .fields import check_real
+from .settings import check_flag
 
 CHUNK = 1024  # query rows per kernel block
 FIT_MAX = 3000  # labelled configurations in the fitted surrogate
@@ -58,89 +72,6 @@ def check_training(gamma: object, beta: object, margin: object, max_iter: object
     check_real("beta", beta, 1e-6, 1e6)
     check_real("margin", margin, -10.0, 10.0, " m")
     check_int(max_iter, "max_iter", 1, MAX_FASTRON_ITER)
-
-
-def same_kinematics(a: Robot, b: Robot) -> bool:
-    """True when robots ``a`` and ``b`` have one name, joint count, limits and node positions
-    (DiffCo's control points) at their lower, upper and middle configurations."""
-    if a is b:
-        return True
-    if (a.name, a.dof, a.n_nodes) != (b.name, b.dof, b.n_nodes):
-        return False
-    if not (np.array_equal(a.lower, b.lower) and np.array_equal(a.upper, b.upper)):
-        return False
-    probe = np.stack([a.lower, a.upper, (a.lower + a.upper) / 2])
-    return bool(np.array_equal(a.node_positions(probe), b.node_positions(probe)))
-
-
-@dataclass(frozen=True)
-class FKKernel:
-    """Rational-quadratic kernel on forward-kinematics control points (see module docstring).
-
-    Attributes:
-        robot: the robot whose node positions are the control points.
-        gamma: inverse squared length scale γ (m⁻²).
-        p: rational-quadratic exponent.
-    """
-
-    robot: Robot
-    gamma: float = 10.0
-    p: float = 2.0
-
-    def features(self, q: np.ndarray) -> np.ndarray:
-        """(B, 2N) control points of q (B, dof), flattened and scaled by 1/√N (m)."""
-        x = self.robot.node_positions(q)
-        return x.reshape(len(x), 2 * x.shape[1]) / np.sqrt(x.shape[1])  # (0, 2N) when B = 0
-
-    def from_features(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Kernel (A, B) and ∂k/∂r² (A, B) between feature rows a (A, 2N) and b (B, 2N)."""
-        r2 = np.maximum((a * a).sum(1)[:, None] + (b * b).sum(1)[None] - 2 * a @ b.T, 0.0)
-        base = 1.0 + self.gamma / self.p * r2
-        return base ** (-self.p), -self.gamma * base ** (-self.p - 1)
-
-    def matrix(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        """(A, B) kernel values between feature rows."""
-        return self.from_features(a, b)[0]
-
-
-def fastron(
-    K: np.ndarray,
-    y: np.ndarray,
-    alpha: np.ndarray,
-    beta: float = 1.0,
-    max_iter: int = 20_000,
-) -> np.ndarray:
-    """Fastron perceptron updates from initial weights.
-
-    Args:
-        K: (n, n) kernel matrix of the training points (unit diagonal).
-        y: (n,) labels ±1 (+1 = collision).
-        alpha: (n,) initial weights (zeros for a fresh model).
-        beta: weight of collision corrections (β > 1 favours conservative predictions).
-        max_iter: update budget.
-
-    Returns:
-        (n,) weights α with sign(K α) = y on the training points when converged.
-    """
-    alpha = alpha.astype(float).copy()
-    F = K @ alpha
-    for _ in range(max_iter):
-        margin = y * F
-        i = int(np.argmin(margin))
-        if margin[i] <= 0:
-            delta = beta ** ((1 + y[i]) / 2) * y[i] - F[i]
-            alpha[i] += delta
-            F += delta * K[:, i]
-            continue
-        active = alpha != 0
-        removable = np.where(active, y * (F - alpha), -np.inf)
-        j = int(np.argmax(removable))
-        if removable[j] > 0 and active.sum() > 1:
-            F -= alpha[j] * K[:, j]
-            alpha[j] = 0.0
-            continue
-        break
-    return alpha
 
 
 @dataclass(frozen=True, eq=False)
@@ -158,6 +89,12 @@ class DiffCo:
         fit_weights: (C,) weights w of the fitted surrogate, or None for the perceptron score.
         beta, margin, ridge: training settings (collision weight, label margin (m), λ of the fit).
         name: display name.
+        obstacles: the obstacle polygons (m_i, 2) (m) of the training scene, or of the scene of
+            the last :meth:`adapt` (read-only copies); None when unknown (a DiffCo built
+            directly), which refuses every scene unless ``ignore_obstacles``.
+        ignore_obstacles: False (the default) refuses a scene whose obstacles are not
+            ``obstacles`` (module docstring); True (:meth:`ignoring_obstacles`) evaluates the
+            trained layout's score in any scene of the robot.
     """
 
     kernel: FKKernel
@@ -170,7 +107,22 @@ class DiffCo:
     margin: float = 0.0
     ridge: float = 1e-3
     name: str = "DiffCo"
+    obstacles: tuple[np.ndarray, ...] | None = None
+    ignore_obstacles: bool = False
     is_distance = False
+
+    def __post_init__(self) -> None:
+        check_flag(self.ignore_obstacles, "ignore_obstacles")
+        if self.obstacles is not None:
+            if not isinstance(self.obstacles, (tuple, list)):
+                raise InputError(
+                    f"obstacles: expected a sequence of polygons (m, 2) or None, got "
+                    f"{type(self.obstacles).__name__}"
+                )
+            polys = layout_of(self.obstacles)
+            if any(p.ndim != 2 or p.shape[1] != 2 or not np.isfinite(p).all() for p in polys):
+                raise InputError("obstacles: expected finite polygons of shape (m, 2) (m)")
+            object.__setattr__(self, "obstacles", polys)
 
     @classmethod
     def train(
@@ -184,14 +136,17 @@ class DiffCo:
         max_iter: int = 20_000,
     ) -> DiffCo:
         """Train on n uniform configurations of ``scene`` labelled by coal (``n`` in 1 …
-        :data:`MAX_POOL`; the other settings: :func:`check_training`)."""
+        :data:`MAX_POOL`; the other settings: :func:`check_training`); the model records
+        ``scene``'s obstacles and refuses scenes with others."""
         check_scene(scene, "planar")
         check_int(n, "n", 1, MAX_POOL, "the kernel matrix is n² numbers")
         check_training(gamma, beta, margin, max_iter)
         kernel = FKKernel(scene.robot, float(gamma))
         q = scene.robot.sample(n, seed=seed)
         d = signed_distance(scene, q)
-        model = cls(kernel, q[:0], np.zeros(0), q, d, beta=beta, margin=margin)
+        model = cls(
+            kernel, q[:0], np.zeros(0), q, d, beta=beta, margin=margin, obstacles=scene.obstacles
+        )
         return model._fit(q, d, np.zeros(n), max_iter)
 
     def _fit(self, q: np.ndarray, d: np.ndarray, alpha0: np.ndarray, max_iter: int) -> DiffCo:
@@ -222,7 +177,9 @@ class DiffCo:
             max_iter: perceptron update budget.
 
         Returns:
-            A new DiffCo (perceptron score; call :meth:`fitted` for the surrogate).
+            A new DiffCo (perceptron score; call :meth:`fitted` for the surrogate) that
+            records ``scene``'s obstacles and checks them (``ignore_obstacles`` False: the
+            copy is for ``scene``, not a stale layout).
         """
         robot = self.kernel.robot
         self.check_robot(scene)
@@ -236,7 +193,14 @@ class DiffCo:
         q = np.concatenate([self.support, near, robot.sample(n_explore, seed=rng)])
         d = signed_distance(scene, q)
         alpha0 = np.r_[self.alpha, np.zeros(len(q) - len(self.support))]
-        return self._fit(q, d, alpha0, max_iter)
+        new = replace(self, obstacles=scene.obstacles, ignore_obstacles=False)
+        return new._fit(q, d, alpha0, max_iter)
+
+    def ignoring_obstacles(self) -> DiffCo:
+        """A copy that evaluates any scene of its robot with the trained layout's score, the
+        scene's obstacles unused (Table I's "DiffCo w/o AL"): the explicit opt-in to a model
+        that does not know the scene it is given (module docstring)."""
+        return replace(self, ignore_obstacles=True)
 
     def fitted(self) -> DiffCo:
         """The smooth surrogate: kernel ridge regression of coal's f over the labelled pool
@@ -270,11 +234,27 @@ class DiffCo:
                 "kinematics; train DiffCo in a scene of this robot (DiffCo.train)"
             )
 
-    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
-        """(B,) −s(q) (or the fitted surrogate); ``scene`` only checks the robot and q
-        (obstacles unused)."""
+    def check_scene(self, scene: Scene) -> None:
+        """InputError unless ``scene`` is a planar scene of this robot (:meth:`check_robot`)
+        among the recorded obstacles (:func:`~gdnplan.models.diffco_scene.layout_difference`;
+        any obstacles when ``ignore_obstacles``)."""
         self.check_robot(scene)
-        q = scene.robot.check_q(q)
+        if self.ignore_obstacles:
+            return
+        if self.obstacles is None:
+            raise unknown_layout_error()
+        why = layout_difference(self.obstacles, scene.obstacles)
+        if why is not None:
+            raise stale_layout_error("scene", why)
+
+    def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
+        """(B,) −s(q) (or the fitted surrogate) at q (B, dof) (rad) in ``scene``, a scene of
+        the training robot and obstacles (:meth:`check_scene`)."""
+        self.check_scene(scene)
+        return self._value(scene.robot.check_q(q))
+
+    def _value(self, q: np.ndarray) -> np.ndarray:
+        """(B,) the value at checked configurations q (B, dof)."""
         feats = self.kernel.features(q)
         sf = self.kernel.features(self.centers)
         out = np.empty(len(q))
@@ -283,16 +263,31 @@ class DiffCo:
         return out
 
     def predict_dataset(self, ds, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
-        """A dataset's samples in one pass (DiffCo ignores their obstacles, see above)."""
-        scene = Scene(self.kernel.robot, ())
-        if grad:
-            return self.distance_and_grad(scene, ds.q)
-        return self.distance(scene, ds.q), None
+        """A dataset's (:class:`gdnplan.data.Dataset`) samples in one pass: (n,) values and,
+        with ``grad``, (n, dof) gradients. Every sample's robot must be the training robot
+        and, unless ``ignore_obstacles``, its obstacles the recorded ones (InputError naming
+        the first sample that differs)."""
+        for rows in ds.variants().values():
+            if len(rows):
+                self.check_robot(Scene(ds.robot(int(rows[0])), ()))
+        if not self.ignore_obstacles:
+            if self.obstacles is None:
+                raise unknown_layout_error()
+            bad = dataset_difference(self.obstacles, ds.obstacles, ds.sizes)
+            if bad is not None:
+                raise stale_layout_error(f"dataset sample {bad[0]}", bad[1])
+        q = self.kernel.robot.check_q(ds.q)
+        return self._value_and_grad(q) if grad else (self._value(q), None)
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """((B,), (B, dof)) the value and its exact gradient through the node Jacobians."""
-        self.check_robot(scene)
-        q = scene.robot.check_q(q)
+        """((B,), (B, dof)) the value and its exact gradient through the node Jacobians at q
+        (B, dof) (rad) in ``scene``, a scene of the training robot and obstacles
+        (:meth:`check_scene`)."""
+        self.check_scene(scene)
+        return self._value_and_grad(scene.robot.check_q(q))
+
+    def _value_and_grad(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """((B,), (B, dof)) value and gradient at checked configurations q (B, dof)."""
         n_nodes = self.kernel.robot.n_nodes
         feats = self.kernel.features(q)  # (B, 2N) = x / √N
         jac = self.kernel.robot.node_jacobians(q).reshape(len(q), 2 * n_nodes, q.shape[1])
@@ -307,3 +302,17 @@ class DiffCo:
             dfeat = 2 * (a * c.sum(1, keepdims=True) - c @ sf) / np.sqrt(n_nodes)
             grad[s : s + CHUNK] = np.einsum("bf,bfj->bj", dfeat, jac[s : s + CHUNK])
         return value, grad
+
+
+__all__ = [
+    "CHUNK",
+    "FIT_MAX",
+    "LAYOUT_TOL",
+    "MAX_FASTRON_ITER",
+    "MAX_POOL",
+    "DiffCo",
+    "FKKernel",
+    "check_training",
+    "fastron",
+    "same_kinematics",
+]
