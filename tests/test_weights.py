@@ -116,16 +116,22 @@ WEIGHTS = Path(__file__).resolve().parent.parent / "weights"
 
 def _pair(tmp_path: Path, name: str, tensors: bytes | None = None, card: str | None = None,
           src: str = "a") -> Path:  # fmt: skip
-    """A weights pair in tmp_path: a copy of the shipped ``src`` pair with either file replaced."""
+    """A weights pair in tmp_path: a copy of the shipped ``src`` pair with either file replaced,
+    sealed (a card that is a JSON object records the tensors' hash), so the checks behind the
+    pair check are reached."""
     path = tmp_path / f"{name}.safetensors"
     if tensors is None:
         shutil.copy(WEIGHTS / f"{src}.safetensors", path)
     else:
         path.write_bytes(tensors)
-    if card is None:
-        shutil.copy(WEIGHTS / f"{src}.json", card_path(path))
-    else:
-        card_path(path).write_text(card)
+    text = (WEIGHTS / f"{src}.json").read_text() if card is None else card
+    try:
+        content = json.loads(text)
+    except ValueError:
+        content = None
+    if isinstance(content, dict):
+        text = json.dumps(content | {TENSORS_HASH: file_sha256(path)})
+    card_path(path).write_text(text)
     return path
 
 
@@ -152,6 +158,15 @@ def _nan_tensors() -> bytes:
     return save({k: torch.full_like(v, float("nan")) for k, v in tensors.items()})
 
 
+def _tensors_as(dtype: torch.dtype, src: str = "a") -> bytes:
+    """The shipped tensors of ``src`` cast to ``dtype`` (load_state_dict cast them back
+    silently: int truncated every weight, complex dropped the imaginary part)."""
+    from safetensors.torch import load_file, save
+
+    tensors = load_file(WEIGHTS / f"{src}.safetensors")
+    return save({k: (v + 0.5j if dtype.is_complex else v).to(dtype) for k, v in tensors.items()})
+
+
 HOSTILE_WEIGHTS = {
     "truncated": lambda: {"tensors": (WEIGHTS / "a.safetensors").read_bytes()[:5000]},
     "header_only": lambda: {"tensors": (WEIGHTS / "a.safetensors").read_bytes()[:8]},
@@ -175,6 +190,18 @@ HOSTILE_WEIGHTS = {
     "bad_tau": lambda: {"card": _config(tau=-1.0)},
     "nan_scale": lambda: {"card": _config(scale=float("nan"))},
     "mlp_int": lambda: {"card": _config(mlp=5)},
+    "int64_tensors": lambda: {"tensors": _tensors_as(torch.int64)},
+    "int8_tensors": lambda: {"tensors": _tensors_as(torch.int8)},
+    "bool_tensors": lambda: {"tensors": _tensors_as(torch.bool)},
+    "complex_tensors": lambda: {"tensors": _tensors_as(torch.complex64)},
+    "clearancenet_int_tensors": lambda: {
+        "tensors": _tensors_as(torch.int32, "clearancenet_a"),
+        "card": (WEIGHTS / "clearancenet_a.json").read_text(),
+    },
+    "3d_int_tensors": lambda: {
+        "tensors": _tensors_as(torch.int32, "ur5e_boxes3d_preliminary"),
+        "card": (WEIGHTS / "ur5e_boxes3d_preliminary.json").read_text(),
+    },
 }
 
 

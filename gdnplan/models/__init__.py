@@ -15,6 +15,7 @@ import numpy as np
 from ..assets import weights_file
 from ..distance import signed_distance, signed_distance_and_grad
 from ..errors import UnknownNameError
+from ..limits import shown
 from ..scene import Scene
 from .threads import inference_threads, set_inference_threads
 
@@ -78,7 +79,11 @@ def load_model(weights: Path | str, threads: int | None = None) -> DistanceModel
         from .graphdistnet3d import load_graphdistnet3d
 
         return load_graphdistnet3d(path, threads)
-    raise UnknownNameError(f"model: unknown model type {kind!r} in {card_path(path).name}")
+    raise UnknownNameError(
+        f'model: unknown model type {shown(kind)} in {card_path(path).name}; its "model" '
+        "field names one of 'graphdistnet', 'clearancenet', 'graphdistnet3d' (a card of "
+        "another tool, or a damaged one: re-download or retrain the weights)"
+    )
 
 
 __all__ = ["CoalModel", "DistanceModel", "inference_threads", "load_model", "set_inference_threads"]

@@ -98,7 +98,8 @@ def card_config(path: Path, card: dict, kind: str, make: Callable[[dict], object
 def build_net(
     path: Path, kind: str, make: Callable[[], torch.nn.Module], tensors: dict[str, torch.Tensor]
 ) -> torch.nn.Module:
-    """The network ``make()`` holding ``tensors``; InputError when they do not fit it.
+    """The network ``make()`` holding ``tensors``; InputError when they do not fit it (a
+    missing or unexpected name, another shape, an int, bool or complex tensor).
 
     The network is first built on the meta device (no memory), so a card asking for a huge
     network costs nothing before its shapes are compared with the file's tensors.
@@ -106,7 +107,8 @@ def build_net(
     card = path.with_suffix(".json").name
     try:
         with torch.device("meta"):
-            expected = {k: tuple(v.shape) for k, v in make().state_dict().items()}
+            meta = make().state_dict()
+        expected = {k: tuple(v.shape) for k, v in meta.items()}
     except (TypeError, ValueError, RuntimeError, OverflowError) as e:
         raise InputError(
             f"weights: card {card} has an invalid {kind} config ({type(e).__name__}: {e}); "
@@ -132,9 +134,25 @@ def build_net(
             f"{card} ({'; '.join(parts)}); the card belongs to other weights, or the file to "
             "another model: keep each .safetensors with its own .json"
         )
+    _check_dtypes(path, {k: v.dtype for k, v in meta.items()}, tensors)
     net = make()
     net.load_state_dict(tensors)
     return net
+
+
+def _check_dtypes(path: Path, expected: dict, tensors: dict[str, torch.Tensor]) -> None:
+    """InputError naming the first tensor that is no real float (int, bool, complex) where the
+    network holds one: ``load_state_dict`` would cast it silently (an int tensor truncates
+    every weight, a complex one drops its imaginary part, a bool one makes every weight 0 or
+    1). Any float width is kept (float16/bfloat16/float64 files load as float32)."""
+    for name, dtype in expected.items():
+        got = tensors[name].dtype
+        if dtype.is_floating_point and not got.is_floating_point:
+            raise InputError(
+                f"weights: {path.name} tensor {name!r} holds {str(got).removeprefix('torch.')} "
+                f"values, the network real numbers (float32); the file was not written by "
+                f"gdnplan's training: {RETRAIN}"
+            )
 
 
 def check_count(value: object, limit: int, name: str, path: Path) -> None:
