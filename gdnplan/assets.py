@@ -19,7 +19,7 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .errors import InputError, UnknownNameError
+from .errors import InputError, UnknownNameError, did_you_mean
 
 if TYPE_CHECKING:
     from .scene import Scene
@@ -80,7 +80,8 @@ def _shipped(ref: str, folder: Path, suffix: str, what: str, names: list[str]) -
     path = folder / f"{ref}{suffix}"
     if not is_file(path, what, ref):
         raise UnknownNameError(
-            f"{what}: no shipped {what} named {ref!r}; choose one of {names} or give a path"
+            f"{what}: no shipped {what} named {ref!r}{did_you_mean(ref, names)}; choose one of "
+            f"{names} or give a path"
         )
     return path
 
@@ -97,6 +98,11 @@ def problem_file(ref: str | Path) -> Path:
 def weights_file(ref: str | Path) -> Path:
     """The weights file ``ref`` names: a path as given, or shipped weights by name."""
     _check_ref(ref, "weights")
+    if looks_like_path(ref) and Path(ref).suffix == ".json":  # else "card … does not belong"
+        raise InputError(
+            f"weights: {ref} is a card; give the weights file beside it, "
+            f"{Path(ref).with_suffix(WEIGHTS_SUFFIX)}"
+        )
     if looks_like_path(ref):
         return Path(ref)
     return _shipped(str(ref), WEIGHTS_DIR, WEIGHTS_SUFFIX, "weights", weights_names())

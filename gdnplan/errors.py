@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 
 class GdnplanError(Exception):
     """Base class of every error gdnplan raises on purpose (the CLI prints it and exits 2)."""
@@ -41,3 +44,13 @@ class InfeasibleProblemError(GdnplanError):
 class OutputError(GdnplanError):
     """An output path that cannot be written: an unknown suffix, a target that is not a regular
     file, a parent that is not a directory, a read-only directory, a full disk."""
+
+
+def did_you_mean(name: object, choices: Iterable[str]) -> str:
+    """`` (did you mean 'x'?)`` naming the choice closest to ``name`` (difflib, ratio ≥ 0.6),
+    else ""; for the messages of unknown names and keys. A name that is no string, or longer
+    than any sensible name (200 characters), gets no suggestion."""
+    if not isinstance(name, str) or len(name) > 200:
+        return ""
+    close = difflib.get_close_matches(name, [c for c in choices if isinstance(c, str)], n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""

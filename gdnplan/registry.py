@@ -15,7 +15,7 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable
 
-from .errors import UnknownNameError
+from .errors import UnknownNameError, did_you_mean
 
 
 class Registry:
@@ -55,7 +55,8 @@ class Registry:
             importlib.import_module(self.builtins[name])
         if name not in self.factories:
             raise UnknownNameError(
-                f"{self.kind}: unknown name {name!r}; choose one of {self.names()}"
+                f"{self.kind}: unknown name {name!r}{did_you_mean(name, self.names())}; "
+                f"choose one of {self.names()}"
             )
         return self.factories[name]
 

@@ -15,7 +15,7 @@ from collections.abc import Callable, Set
 
 import numpy as np
 
-from .errors import InputError, ProblemFileError, UnknownNameError
+from .errors import InputError, ProblemFileError, UnknownNameError, did_you_mean
 from .geometry import as_polygon, check_part, convex_decomposition
 from .robot import Robot
 
@@ -82,8 +82,9 @@ def no_unknown_keys(table: dict, allowed: Set[str], where: str) -> None:
     """ProblemFileError naming the keys of ``table`` not in ``allowed`` and listing these."""
     unknown = sorted(set(table) - allowed)
     if unknown:
+        hint = did_you_mean(unknown[0], allowed)
         raise ProblemFileError(
-            f"{where}: unknown key(s) {unknown}; allowed: {sorted(allowed)}", schema=True
+            f"{where}: unknown key(s) {unknown}{hint}; allowed: {sorted(allowed)}", schema=True
         )
 
 

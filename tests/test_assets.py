@@ -64,6 +64,30 @@ def test_unknown_weights_name_lists_the_names(ref):
         gp.load_model(ref)
 
 
+@pytest.mark.parametrize(
+    ("load", "ref", "close"),
+    [
+        (lambda r: gp.load_model(r), "clearancenet_f", "clearancenet_e"),
+        (lambda r: gp.Problem.from_toml(r), "fetch_reahc", "fetch_reach"),
+        (lambda r: gp.make_scene(r), "fech", "fetch"),
+        (lambda r: gp.load_robot(r), "planar8", "planar7"),
+        (lambda r: gp.arm3d.load_robot3d(r), "pand", "panda"),
+    ],
+)
+def test_a_misspelt_name_gets_the_closest_one(load, ref, close):
+    with pytest.raises(gp.UnknownNameError, match=rf"'{ref}' \(did you mean '{close}'\?\); choose"):
+        load(ref)
+    with pytest.raises(gp.UnknownNameError) as e:
+        load("qqqqqqqqqqqq")
+    assert "did you mean" not in str(e.value)
+
+
+def test_a_card_given_for_its_weights_names_the_weights_file():
+    """It was read as a tensors file: 'card a.json does not belong to a.json'."""
+    with pytest.raises(gp.InputError, match=r"a\.json is a card; give the weights file beside it"):
+        gp.load_model(assets.WEIGHTS_DIR / "a.json")
+
+
 def test_a_path_is_never_taken_for_a_name(tmp_path):
     with pytest.raises(gp.GdnplanError, match="does not exist"):
         gp.load_model(tmp_path / "d.safetensors")

@@ -105,3 +105,17 @@ def test_a_far_goal_position_is_out_of_reach_without_overflow(tmp_path_factory, 
     message = str(info.value)
     assert isinstance(info.value, InfeasibleProblemError) and "out of reach" in message
     assert "inf m" not in message and "the tip reaches" in message
+
+
+@pytest.mark.parametrize(
+    ("table", "typo", "meant"),
+    [("options", "margn", "margin"), ("seed", "rrt_stepp", "rrt_step"), ("goal", "qq", "q")],
+)
+def test_an_unknown_key_names_the_closest_allowed_one(tmp_path, table, typo, meant):
+    path = tmp_path / "p.toml"
+    text = SQUARE.read_text()
+    header = f"[{table}]\n"
+    text = text.replace(header, f"{header}{typo} = 1\n") if header in text else text
+    path.write_text(text if header in text else f"{text}\n{header}{typo} = 1\n")
+    with pytest.raises(ProblemFileError, match=rf"\['{typo}'\] \(did you mean '{meant}'\?\)"):
+        Problem.from_toml(path)

@@ -21,7 +21,8 @@ from functools import cache
 from pathlib import Path
 
 from ..assets import robot_urdf
-from ..errors import InputError, UnknownNameError
+from ..errors import InputError, UnknownNameError, did_you_mean
+from ..limits import shown
 from ..ur5e.kinematics import JOINTS
 from .robot3d import Robot3D, robot3d_from_urdf
 
@@ -86,7 +87,8 @@ def load_robot3d(name: str) -> Robot3D:
     """
     if name not in FACTORIES:
         raise UnknownNameError(
-            f"robot: unknown 3-D robot {name!r}; choose one of {list(FACTORIES)}"
+            f"robot: unknown 3-D robot {shown(name)}{did_you_mean(name, FACTORIES)}; choose one "
+            f"of {list(FACTORIES)}"
         )
     return _cached(name)
 
