@@ -17,7 +17,8 @@ along a path that is certified collision-free:
     bounds of |q̇_j| and |q̈_j| over every grid cell (:func:`~gdnplan.timing_toppra.cell_bounds`)
     hold with ``STRETCH_SLACK`` to spare (velocities scale by 1/c, accelerations by 1/c²).
     The curve leaves the polygon, so it gets its own certificate (:mod:`gdnplan.ccd_curve`).
-``stop`` (acceleration limits, no scene or the smooth curve not certified): the exact polygon,
+``stop`` (acceleration limits, no scene, the smooth curve not certified or not representable:
+    a waypoint step too short for float64 cubics, ≲ 1e-154 rad): the exact polygon,
     at rest at every waypoint, each segment the time-optimal trapezoidal (or triangular) profile
     of σ ∈ [0, 1] under σ̇ ≤ min_j v_j / |Δq_j| and |σ̈| ≤ min_j a_j / |Δq_j|. A polygon
     with corners cannot be followed exactly at bounded acceleration without stopping at them.
@@ -54,7 +55,7 @@ from .timing_checks import (
     urdf_velocity,
 )
 from .timing_profiles import LinearProfile, StopProfile
-from .timing_toppra import cell_bounds, chord_knots, toppra_profile
+from .timing_toppra import cell_bounds, chord_knots, pchip_curve, toppra_profile
 
 KINDS = ("linear", "smooth", "stop")
 
@@ -131,8 +132,9 @@ def time_path(
             :data:`LIMIT_RANGE` (10⁻⁶ … 10⁹), so the duration and every time stay finite.
         max_acceleration: acceleration limit (rad/s²) likewise; None: ``linear``.
         scene: with max_acceleration, try the ``smooth`` curve and certify it here (a planar
-            ``Scene`` or a ``Scene3D``); None (or a curve whose certificate fails, or toppra
-            finding no solution): ``stop``.
+            ``Scene`` or a ``Scene3D``); None (or a curve whose certificate fails, toppra
+            finding no solution, or a waypoint step too short for a float64 cubic,
+            :func:`~gdnplan.timing_toppra.pchip_curve`): ``stop``.
         clearance: the ``smooth`` curve must be proven to keep the exact distance above this
             (m, finite, ≥ 0): the certified plan's clearance, so that the curve the robot
             follows keeps what the plan promised; else ``stop`` (the certified polygon).
@@ -147,11 +149,8 @@ def time_path(
         return TimedTrajectory("linear", prof.times, q, v, None, None, prof)
     a = limit_vector(max_acceleration, q.shape[1], "max_acceleration", "rad/s²")
     knots, index = chord_knots(q)
-    if scene is not None and len(knots) > 1:
-        # imported here: a slow import (docs/decisions.md#lazy-imports)
-        from scipy.interpolate import PchipInterpolator
-
-        curve = PchipInterpolator(knots, q[np.unique(index, return_index=True)[1]], axis=0)
+    curve = None if scene is None else pchip_curve(knots, q[np.unique(index, return_index=True)[1]])
+    if curve is not None:
         cert = certify_curve(scene, curve, margin=clearance)
         prof = toppra_profile(curve, knots, v, a) if cert.ok else None
         if prof is not None and math.isfinite(prof.c * prof.ts[-1]):

@@ -19,12 +19,41 @@ STRETCH_SLACK = 1e-9  # c is raised by this fraction (rounding of the cell bound
 
 
 def chord_knots(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Cumulative chord length of the distinct waypoints (K,) and each waypoint's knot (T,)."""
+    """Cumulative chord length of the distinct waypoints (K,) and each waypoint's knot (T,).
+
+    Each chord is the scaled norm h = m ‖Δq / m‖ with m = max_j |Δq_j| (rad), so a step whose
+    squared components underflow (|Δq| ≲ 1e-154 rad) still has h ≥ m > 0 (a plain ‖Δq‖ gave 0:
+    two distinct waypoints on one knot). Knots can still repeat (a step below the rounding of
+    the knot before it); :func:`pchip_curve` refuses them.
+    """
     keep = np.concatenate([[True], np.any(np.diff(q, axis=0) != 0, axis=1)])
     index = np.cumsum(keep) - 1
-    distinct = q[keep]
-    knots = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(distinct, axis=0), axis=1))])
+    step = np.diff(q[keep], axis=0)
+    scale = np.max(np.abs(step), axis=1, initial=0.0)
+    unit = step / np.where(scale > 0, scale, 1.0)[:, None]
+    knots = np.concatenate([[0.0], np.cumsum(scale * np.linalg.norm(unit, axis=1))])
     return knots, index
+
+
+def pchip_curve(knots: np.ndarray, points: np.ndarray):
+    """The PCHIP curve p(s) through ``points`` (K, dof) rad at ``knots`` (K,), a cubic
+    ``PPoly``; None when there is no segment or float64 cannot hold the curve.
+
+    That is: knots not strictly increasing (a waypoint step below the rounding of the chord
+    length before it), or a coefficient that is not finite. The secant slopes are at most 1
+    (chord parameter), so a piece of chord h (rad) has a cubic coefficient up to ~1 / h²,
+    which overflows for h ≲ 1e-154 rad: the coefficients became inf and NaN, and the
+    certificate then raised on NaN configurations, or SciPy on repeated knots (a step whose
+    chord underflowed to 0). The caller times the polygon instead.
+    """
+    if len(knots) < 2 or not np.all(np.diff(knots) > 0):
+        return None
+    # imported here: a slow import (docs/decisions.md#lazy-imports)
+    from scipy.interpolate import PchipInterpolator
+
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        curve = PchipInterpolator(knots, points, axis=0)
+    return curve if np.all(np.isfinite(curve.c)) else None
 
 
 def toppra_profile(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> SmoothProfile | None:
@@ -143,5 +172,6 @@ __all__ = [
     "cell_bounds",
     "chord_knots",
     "max_abs_quadratic",
+    "pchip_curve",
     "toppra_profile",
 ]

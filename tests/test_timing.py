@@ -146,6 +146,25 @@ def test_smooth_respects_the_limits_and_stays_in_the_waypoint_boxes(free, case):
     assert np.all((q_all >= lo - 1e-9) & (q_all <= hi + 1e-9))
 
 
+@settings(max_examples=30, deadline=None)
+@given(st.integers(1, 323), st.integers(0, 2), st.integers(0, 1))
+@example(200, 0, 0)  # chord underflowed to 0: two distinct waypoints on one knot (ValueError)
+@example(157, 0, 1)  # the cubic's coefficients overflowed: NaN configurations (InputError)
+def test_a_tiny_waypoint_step_is_timed_through_every_waypoint(free, exponent, where, joint):
+    """A step of 10^−exponent rad anywhere in the path: the smooth curve where float64 holds
+    it, else the stop polygon (timing_toppra.pchip_curve), never an error; each waypoint is
+    reached at its time and the limits hold."""
+    step = np.zeros(2)
+    step[joint] = 10.0**-exponent
+    corner = [np.zeros(2), np.array([1.0, 1.0]), np.array([2.0, 0.0])]
+    q = np.array([*corner[: where + 1], corner[where] + step, *corner[where + 1 :]])
+    traj = time_path(q, 1.0, 2.0, free[2])
+    assert traj.kind in ("smooth", "stop")
+    np.testing.assert_allclose(traj.evaluate(traj.times)[0], q, rtol=0, atol=1e-9)
+    _, qd, qdd = traj.evaluate(np.linspace(0.0, traj.duration, 2000))
+    assert np.all(np.abs(qd) <= 1.0 + REL) and np.all(np.abs(qdd) <= 2.0 + REL)
+
+
 @settings(max_examples=60, deadline=None)
 @given(st.integers(0, 2**31), st.integers(1, 4), st.integers(2, 8))
 def test_total_variation_of_a_cubic_is_exact(seed, dof, n):
