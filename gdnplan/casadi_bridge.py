@@ -27,6 +27,7 @@ import numpy as np
 
 from .distance import checker, witness_gradient
 from .errors import InputError
+from .flags import check_flag
 from .limits import check_int, is_number
 from .models import CoalModel, DistanceModel
 from .scene import Scene, check_scene
@@ -130,8 +131,7 @@ def check_callback(name, model, scene, n_points, per_link, cap) -> None:
     if callable(getattr(model, "check_scene", None)):
         model.check_scene(scene)
     check_int(n_points, "n_points", 1, MAX_POINTS)
-    if not isinstance(per_link, (bool, np.bool_)):
-        raise InputError(f"per_link: expected True or False, got {per_link!r}")
+    check_flag(per_link, "per_link")
     if not is_number(cap) or not cap > 0:
         raise InputError(f"cap: expected a number > 0 (m) or inf, got {cap!r}")
 

@@ -56,6 +56,7 @@ import numpy as np
 
 from .distance import signed_distance
 from .errors import InputError
+from .flags import check_flag
 from .limits import check_int, check_number, is_number, shown
 from .robot import Robot
 from .scene import Scene, check_scene
@@ -147,15 +148,14 @@ def check_certify_args(
     margin: float, tol: float, min_splits: int, max_checks: int, stop_early: bool
 ) -> None:
     """InputError naming the first bad argument of a certificate (:func:`certify_path`,
-    :func:`gdnplan.arm3d.certify_path3d`): ``stop_early`` is True or False (not 1, not a
-    string, which would be taken as true)."""
+    :func:`gdnplan.arm3d.certify_path3d`): ``stop_early`` is a flag
+    (:func:`gdnplan.flags.check_flag`: not 1, not a string, which would be taken as true)."""
     check_number(margin, "margin")
     if not (is_number(tol) and tol > 0) or math.isnan(tol):
         raise InputError(f"tol: expected a number > 0 (m) or inf, got {shown(tol)}")
     check_int(min_splits, "min_splits", 1, MAX_SPLITS)
     check_int(max_checks, "max_checks", 1, MAX_CHECKS)
-    if not isinstance(stop_early, bool):
-        raise InputError(f"stop_early: expected True or False, got {shown(stop_early)}")
+    check_flag(stop_early, "stop_early")
 
 
 def _initial_pieces(q_path: np.ndarray, splits: int):

@@ -25,6 +25,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
         (
             "errors",
             "limits",
+            "flags",  # the one check of an on/off setting
             "files",
             "assets",
             "geometry",

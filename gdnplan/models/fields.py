@@ -28,6 +28,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .. import flags
 from ..errors import InputError
 from ..limits import check_int, fits_float, shown
 
@@ -55,10 +56,9 @@ def check_real(name: str, value: object, low: float, high: float, unit: str = ""
 
 
 def check_flag(name: str, value: object) -> bool:
-    """``value`` when it is True or False (JSON ``true`` / ``false``; not 0 / 1, not a string)."""
-    if not isinstance(value, bool):
-        raise InputError(f"{name}: expected true or false, got {shown(value)}")
-    return value
+    """``value`` as a Python bool when it is True or False (JSON ``true`` / ``false``, a numpy
+    bool; not 0 / 1, not a string): :func:`gdnplan.flags.check_flag`."""
+    return flags.check_flag(value, name, lowercase=True)
 
 
 def check_choice(name: str, value: object, choices: Sequence[str]) -> str:

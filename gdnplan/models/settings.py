@@ -8,6 +8,7 @@ import copy
 
 import torch
 
+from .. import flags
 from ..errors import InputError
 from ..limits import check_int
 
@@ -41,14 +42,9 @@ def check_chunk(chunk) -> int | None:
 
 
 def check_flag(value, name: str, optional: bool = False) -> bool | None:
-    """True or False (or None when ``optional``), else InputError naming ``name``: "yes" or
-    1 are no settings."""
-    if value is None and optional:
-        return None
-    if not isinstance(value, bool):
-        allowed = "True, False or None" if optional else "True or False"
-        raise InputError(f"{name}: expected {allowed}, got {value!r}")
-    return value
+    """True or False, a numpy bool included (or None when ``optional``), as a Python bool, else
+    InputError naming ``name``: "yes" or 1 are no settings (:func:`gdnplan.flags.check_flag`)."""
+    return flags.check_flag(value, name, optional)
 
 
 def placed(net: torch.nn.Module, device: torch.device, dtype: torch.dtype) -> torch.nn.Module:

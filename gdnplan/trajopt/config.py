@@ -25,6 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 
 from ..errors import InputError
+from ..flags import check_flag
 from ..limits import (
     MAX_ADAM_ITERATIONS,
     MAX_INTERPOLATED,
@@ -51,9 +52,10 @@ DEFAULT_SEEDS = 3
 
 
 def _check_bools(cfg, names: tuple[str, ...]) -> None:
+    """Each flag ``names`` of the frozen ``cfg`` checked (:func:`gdnplan.flags.check_flag`) and
+    stored as a Python bool (a numpy bool would not serialise to JSON)."""
     for name in names:
-        if not isinstance(getattr(cfg, name), bool):
-            raise InputError(f"{name}: expected true or false, got {shown(getattr(cfg, name))}")
+        object.__setattr__(cfg, name, check_flag(getattr(cfg, name), name, lowercase=True))
 
 
 @dataclass(frozen=True)

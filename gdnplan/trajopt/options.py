@@ -8,6 +8,7 @@ import warnings
 from dataclasses import dataclass, field, fields
 
 from ..errors import InputError
+from ..flags import check_flag
 from ..limits import (
     MAX_ADAM_ITERATIONS,
     MAX_INTERPOLATED,
@@ -149,8 +150,7 @@ class TrajoptOptions:
         if self.initial not in INITIAL_GUESSES:
             raise InputError(f"initial: unknown {self.initial!r}; choose one of {INITIAL_GUESSES}")
         for name in ("ccd", "warm_start") + (("per_link",) if self.per_link is not None else ()):
-            if not isinstance(getattr(self, name), bool):
-                raise InputError(f"{name}: expected true or false, got {getattr(self, name)!r}")
+            object.__setattr__(self, name, check_flag(getattr(self, name), name, lowercase=True))
         check_int(self.refine_rounds, "refine_rounds", 0, MAX_REFINE_ROUNDS)
         if self.interpolated is not None:
             check_int(self.interpolated, "interpolated", 0, MAX_INTERPOLATED)
