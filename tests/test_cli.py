@@ -274,6 +274,27 @@ def test_unexpected_exception_is_one_line_exit_3_and_debug_shows_the_traceback()
     assert proc.stderr.splitlines()[-1].startswith("error: internal error (ZeroDivisionError")
 
 
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+@pytest.mark.parametrize(
+    "args", [["--help"], ["--version"], ["plan", "--help"]], ids=lambda a: " ".join(a)
+)
+def test_a_full_standard_output_is_one_line_exit_2(args):
+    """`gdnplan … > /dev/full` was exit 3, an internal error (OSError: No space left)."""
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run(
+            [sys.executable, "-m", "gdnplan", *args], stdout=full, stderr=subprocess.PIPE, text=True
+        )
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.splitlines() == [
+        "error: standard output: cannot write (No space left on device); redirect it"
+    ]
+
+
+def test_an_os_error_elsewhere_stays_an_internal_error():
+    proc = _cli(BOOM.format("OSError(28, 'No space left on device')"), "show", "d")
+    assert proc.returncode == 3 and proc.stderr.startswith("error: internal error (OSError")
+
+
 def test_interrupt_is_one_line_exit_130():
     proc = _cli(BOOM.format("KeyboardInterrupt"), "show", "d")
     assert proc.returncode == 130 and proc.stderr.splitlines() == ["error: interrupted"]

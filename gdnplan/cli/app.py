@@ -3,6 +3,9 @@ and the exit status of :mod:`gdnplan.cli`."""
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import os
 import sys
 import traceback
 import warnings
@@ -76,14 +79,51 @@ def run(args: list[str] | None = None) -> None:
         code = _fail(e, one_line(str(e)), EXIT_INPUT)
     except (KeyboardInterrupt, typer.Abort) as e:
         code = _fail(e, "interrupted", EXIT_INTERRUPTED)
+    except OSError as e:  # a full disk or a closed pipe behind stdout: no bug of gdnplan
+        why = f"standard output: cannot write ({e.strerror or type(e).__name__}); redirect it"
+        code = _fail(e, why, EXIT_INPUT) if _stdout_failed(e) else _internal(e)
     except Exception as e:  # the last resort: a bug, never a traceback without --debug
-        why = f"{type(e).__name__}: {one_line(str(e))}" if str(e) else type(e).__name__
-        message = f"internal error ({why}); rerun with --debug for the traceback"
-        code = _fail(e, message, EXIT_INTERNAL)
+        code = _internal(e)
     finally:
         hide_progress()
         warnings.showwarning = shown
     sys.exit(code if isinstance(code, int) else 0)
+
+
+def _internal(e: Exception) -> int:
+    """Print a bug's one line ``internal error (…)``; returns :data:`EXIT_INTERNAL`."""
+    why = f"{type(e).__name__}: {one_line(str(e))}" if str(e) else type(e).__name__
+    return _fail(e, f"internal error ({why}); rerun with --debug for the traceback", EXIT_INTERNAL)
+
+
+OUTPUT_ERRNOS = {errno.EPIPE, errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG}
+
+
+def _stdout_failed(e: OSError) -> bool:
+    """``e`` came from writing standard output (``> /dev/full``, a full disk, a reader that
+    closed the pipe): its errno is a write failure and the innermost frame of its traceback was
+    writing to a stream on file descriptor 1 (library files raise OutputError, never a bare
+    OSError). Standard output is then pointed at the null device, so the interpreter's own
+    flush at exit does not fail again."""
+    if e.errno not in OUTPUT_ERRNOS:
+        return False
+    tb = e.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    streams = tb.tb_frame.f_locals.values() if tb is not None else ()
+    if not any(_on_stdout(v) for v in streams):
+        return False
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return True
+
+
+def _on_stdout(value: object) -> bool:
+    """``value`` is a stream writing to file descriptor 1."""
+    try:
+        return hasattr(value, "write") and value.fileno() == 1
+    except (OSError, ValueError, AttributeError, TypeError):  # a closed or in-memory stream
+        return False
 
 
 def _warning_line(message, category, filename, lineno, file=None, line=None) -> None:
