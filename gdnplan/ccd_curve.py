@@ -11,8 +11,19 @@ included, contact-only pairs with the offset of :mod:`gdnplan.arm3d.ccd3d`). A
 straight piece has ∫|q̇_j| = |Δq_j|; a cubic
 piece p_j(s), s ∈ [s_a, s_b], has the total variation TV_j = Σ_i |p_j(x_{i+1}) − p_j(x_i)| over
 x = s_a, the roots of the quadratic p'_j inside the piece, s_b (exact: p_j is monotone between
-them). With d̲ the proven coal distance at the piece's ends (:func:`gdnplan.ccd.proven_distance`,
-with the scene's swept radius :func:`gdnplan.exact.swept_radius_of`),
+them). The ends' distances are taken at the curve's values p(s_a), p(s_b) as the PPoly
+evaluates them, which at a breakpoint is the next piece's polynomial: a PPoly need not be
+continuous, and p_cell(s_b⁻) − p(s_b) is a jump the robot would have to travel too. Each joint's
+travel is therefore
+
+    T_j = |p_cell,j(s_a) − p_j(s_a)| + TV_j + |p_cell,j(s_b) − p_j(s_b)|      (rad)
+
+(p_cell the piece's own cubic; the two end terms are the jumps, zero up to rounding for a C⁰
+curve such as PCHIP): d is Lipschitz along the straight joint segment bridging a jump with the
+same lever arms, so the bound below holds for any PPoly, continuous or not (a discontinuous
+curve moving into an obstacle just before a breakpoint and jumping back was certified). With
+d̲ the proven coal distance at the piece's ends (:func:`gdnplan.ccd.proven_distance`, with the
+scene's swept radius :func:`gdnplan.exact.swept_radius_of`) and δ from T,
 
     d(p(s)) ≥ (d̲(p(s_a)) + d̲(p(s_b)) − δ) / 2     for every s ∈ [s_a, s_b],
 
@@ -37,6 +48,21 @@ from .scene import check_scene
 
 CURVE_SPLITS = 4  # pieces each knot interval starts with
 CURVE_MAX_CHECKS = 200_000  # coal evaluations allowed
+
+
+def _travel(curve, sa: np.ndarray, sb: np.ndarray) -> np.ndarray:
+    """(N, dof) per-joint travel T_j of the module docstring over pieces [sa, sb] (N,), each
+    inside one polynomial interval: the piece's total variation plus the jumps between its cubic
+    and the curve's values p(sa), p(sb) at its ends (rad)."""
+    cell = np.clip(np.searchsorted(curve.x, sa, side="right") - 1, 0, len(curve.x) - 2)
+    c = curve.c[:, cell]  # (4, N, dof)
+
+    def own(s: np.ndarray) -> np.ndarray:  # the piece's cubic at s (N,)
+        x = (s - curve.x[cell])[:, None]
+        return ((c[0] * x + c[1]) * x + c[2]) * x + c[3]
+
+    jumps = np.abs(own(sa) - curve(sa)) + np.abs(own(sb) - curve(sb))
+    return _total_variation(curve, sa, sb) + jumps
 
 
 def _total_variation(curve, sa: np.ndarray, sb: np.ndarray) -> np.ndarray:
@@ -85,7 +111,8 @@ def certify_curve(
 
     Args:
         scene: robot and obstacles, a planar ``Scene`` or a ``Scene3D``.
-        curve: a cubic ``scipy.interpolate.PPoly`` (e.g. a PchipInterpolator) of shape (dof,).
+        curve: a cubic ``scipy.interpolate.PPoly`` (e.g. a PchipInterpolator) of shape (dof,),
+            its breakpoints finite and increasing; it may jump at them (module docstring).
         margin: clearance to prove (m), finite and ≥ 0.
         tol: bisect until the proven bound is within ``tol`` of the smallest checked distance
             (m), finite and > 0.
@@ -99,6 +126,11 @@ def certify_curve(
     check_int(max_checks, "max_checks", 1, MAX_CHECKS)
     if curve.c.ndim != 3 or curve.c.shape[0] != 4 or curve.c.shape[2] != scene.robot.dof:
         raise InputError(f"curve: expected a cubic PPoly of {scene.robot.dof} joints")
+    if not (np.all(np.isfinite(curve.x)) and np.all(np.diff(curve.x) > 0)):
+        raise InputError(  # a descending PPoly: the pieces' cells would be looked up wrongly
+            "curve: expected finite, strictly increasing breakpoints (PPoly.x); reverse a "
+            "descending curve's parameter"
+        )
     robot = scene.robot
     zero = np.zeros(robot.dof)
     x = curve.x
@@ -115,7 +147,7 @@ def certify_curve(
     while len(sa):
         if np.any(da <= margin) or np.any(db <= margin):
             return CurveCertificate(False, -math.inf, n_checks)
-        delta = motion_bound_of(robot, zero[None], _total_variation(curve, sa, sb))
+        delta = motion_bound_of(robot, zero[None], _travel(curve, sa, sb))
         bound = (da + db - delta) / 2
         proven = (bound > margin) & (bound >= best - tol)
         if proven.any():
