@@ -44,6 +44,7 @@ from multiprocessing import get_context
 import coal
 import numpy as np
 
+from .flags import check_flag
 from .robot import cross_z
 from .scene import Scene, check_scene
 
@@ -246,6 +247,7 @@ def _closest_in_worker(q: np.ndarray, per_link: bool) -> Witness:
 
 def closest(scene: Scene, q: np.ndarray, per_link: bool = False) -> Witness:
     """Witnesses of a batch, split over all cores (forked workers) for large batches."""
+    per_link = check_flag(per_link, "per_link")
     workers = min(os.cpu_count() or 1, len(q) // (PARALLEL_MIN_BATCH // 2))
     if workers < 2 or get_context().get_start_method() != "fork":
         return checker(scene).closest(q, per_link)

@@ -27,6 +27,7 @@ import numpy as np
 from .ccd import Certificate, proven_distance
 from .errors import InputError
 from .exact import certify, exact_distance, swept_radius_of
+from .flags import check_flag
 from .limits import check_number
 from .robot import as_batch, first_outside
 from .rrt import edge_free
@@ -208,6 +209,7 @@ def plan_ompl(
     anytime planner's result depends on how far it got in its time). Raises InputError on bad
     input or without OMPL.
     """
+    simplify = check_flag(simplify, "simplify")
     start, goal, lower, upper = _check(
         scene, start, goal, lower, upper, clearance, time_limit, planner
     )

@@ -12,6 +12,7 @@ import numpy as np
 
 from .distance import signed_distance_and_grad
 from .env_models import graphdistnet_of_env
+from .flags import check_flag
 from .metrics import DEFAULT_MARGIN, Result, roc_curve
 
 log = logging.getLogger(__name__)
@@ -54,6 +55,7 @@ def fig5(env: str = "a", grid: int = 101, diffco_train: int = 3000, progress: bo
     from .scene import make_scene
     from .viz import distance_field, field_figure
 
+    progress = check_flag(progress, "progress")
     scene = make_scene(env, seed=0)
     models = {"coal f (m)": CoalModel()}
     t0 = time.perf_counter()

@@ -12,17 +12,23 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import gdnplan as gp
+from gdnplan.arm3d import Scene3D, box_obstacle, checker3d, load_robot3d
 from gdnplan.casadi_bridge import DistanceCallback
 from gdnplan.ccd import certify_path
+from gdnplan.data.sampling import make_shard
 from gdnplan.errors import InputError
 from gdnplan.flags import check_flag
 from gdnplan.models import fields
 from gdnplan.models import settings as model_settings
 from gdnplan.models.graphdistnet import GraphDistNetConfig
+from gdnplan.ompl_planner import plan_ompl
+from gdnplan.paper_figures import fig5
+from gdnplan.train.graphdistnet import TrainConfig
 from gdnplan.trajopt.config import IpoptConfig, RefineConfig
 from gdnplan.trajopt.options import TrajoptOptions
 
 SCENE = gp.make_scene("a")
+SCENE3D = Scene3D(load_robot3d("ur5e"), [box_obstacle((0.1, 0.1, 0.1), (0.5, 0.0, 0.3))])
 FLAGS = st.sampled_from([True, False, np.True_, np.False_]) | st.builds(
     lambda b: np.array([b])[0], st.booleans()
 )
@@ -49,7 +55,16 @@ def sites():
         "DistanceCallback per_link": lambda v: (
             DistanceCallback("f", gp.CoalModel(), SCENE, 1, per_link=v) and v
         ),
+        "signed_distance per_link": lambda v: gp.signed_distance(SCENE, q, per_link=v).ndim == 2,
+        "Checker3D per_link": lambda v: _evaluate3d(per_link=v).distance.ndim == 2,
+        "Checker3D broad_phase": lambda v: _evaluate3d(broad_phase=v) is not None and v,
+        "Checker3D gradient": lambda v: _evaluate3d(gradient=v).gradient is not None,
+        "TrainConfig.compile": lambda v: TrainConfig(compile=v).compile,
     }
+
+
+def _evaluate3d(**flags):
+    return checker3d(SCENE3D).evaluate(np.zeros((1, 6)), **flags)
 
 
 def _options(**kwargs):
@@ -95,3 +110,15 @@ def test_optional_flags_take_none_and_name_it():
         model_settings.check_flag(1, "fused", optional=True)
     with pytest.raises(InputError, match=r"^ccd: expected true or false, got 'yes'$"):
         check_flag("yes", "ccd", lowercase=True)
+
+
+@pytest.mark.parametrize("value", [1, "no", None, np.int64(0)])
+def test_flags_of_long_calls_are_checked_before_the_work(value, tmp_path):
+    q = np.zeros(2)
+    with pytest.raises(InputError, match=r"^simplify: expected True or False"):
+        plan_ompl(SCENE, q, q, 0.0, simplify=value)
+    with pytest.raises(InputError, match=r"^progress: expected True or False"):
+        fig5("a", progress=value)
+    with pytest.raises(InputError, match=r"^compact: expected True or False"):
+        make_shard("a", 0, 0, 2).save(tmp_path / "x.npz", compact=value)
+    assert not (tmp_path / "x.npz").exists()

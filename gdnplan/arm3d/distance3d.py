@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..flags import check_flag
 from ..scene import check_scene
 from .gradient3d import pair_gradients
 from .narrow3d import PairTable, check_cap, check_offset
@@ -157,6 +158,14 @@ class Checker3D(PairTable):
         """
         q = self.robot.check_q(q)
         cap = check_cap(cap)
+        per_link, broad_phase, gradient = (
+            check_flag(v, n)
+            for v, n in (
+                (per_link, "per_link"),
+                (broad_phase, "broad_phase"),
+                (gradient, "gradient"),
+            )
+        )
         offsets = self.offsets(contact_offset)
         tf, bounds = self.placements_batch(q)
         rows = [

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..files import atomic_path
+from ..flags import check_flag
 from ..robot import Robot, load_robot
 from ..scene import ENV_ROBOT, Scene, make_scene
 from ..ur5e import GRIPPER_STATES
@@ -94,6 +95,7 @@ class Dataset:
     def save(self, path: Path | str, compact: bool = False) -> None:
         """Write one ``.npz`` (atomic). ``compact`` drops ``nodes`` and stores float32 polygons."""
         path = Path(path)
+        compact = check_flag(compact, "compact")
         arrays = {f: getattr(self, f) for f in FIELDS}
         arrays |= {f: getattr(self, f) for f in ROBOT_FIELDS if getattr(self, f) is not None}
         if compact:

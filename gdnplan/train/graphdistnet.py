@@ -24,6 +24,7 @@ from safetensors.torch import load_file
 
 from ..data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from ..errors import InputError
+from ..flags import check_flag
 from ..metrics import roc_auc, sha256_prefix, used_cosine_distances
 from ..models.graphdistnet import GraphDistNet, GraphDistNetConfig
 from ..models.weights import read_card
@@ -68,6 +69,7 @@ class TrainConfig:
         n = self.n_train
         if n is not None and (isinstance(n, bool) or not isinstance(n, int) or n < 2):
             raise InputError(f"n_train: expected an integer ≥ 2, got {n!r}")
+        object.__setattr__(self, "compile", check_flag(self.compile, "compile"))
         if self.compile and self.loss.grad_weight > 0:
             raise InputError(
                 "compile: the gradient loss (grad_weight > 0) differentiates ∂d̂/∂q, a double "
