@@ -121,6 +121,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "table1_rows",
             "table1_text",
             "table2",
+            "table2_records",
+            "table2_text",
             "ablation",
             "ablation_steps",
             "ablation_scores",
