@@ -11,7 +11,7 @@ import coal
 import numpy as np
 import pytest
 import tomli_w
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from gdnplan.arm3d import Scene3D, cloud_obstacle, load_robot3d, read_cloud
@@ -100,6 +100,42 @@ def test_point_files_npy_and_text(tmp_path):
             read_cloud(tmp_path / name)
     with pytest.raises(GdnplanError, match="does not exist"):
         read_cloud(tmp_path / "missing.xyz")
+
+
+def _npy_claiming(shape: tuple[int, ...], body: bytes = b"") -> bytes:
+    """A version-1.0 .npy file whose header claims float64 ``shape``, followed by ``body``."""
+    import io
+
+    buf = io.BytesIO()
+    header = {"descr": "<f8", "fortran_order": False, "shape": shape}
+    np.lib.format.write_array_header_1_0(buf, header)
+    return buf.getvalue() + body
+
+
+@settings(
+    max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(k=st.integers(1, 2**40), held=st.integers(0, 64))
+@example(k=10**11, held=3)
+def test_a_npy_header_claiming_more_than_its_file_is_refused_before_allocating(tmp_path, k, held):
+    """np.load allocated the claimed size first: a 100-byte file claiming 10¹¹ points raised
+    MemoryError (2.4 TB), or filled the memory; now an InputError naming the file."""
+    if k * 3 * 8 <= held:
+        return
+    path = tmp_path / "claims.npy"
+    path.write_bytes(_npy_claiming((k, 3), b"\0" * held))
+    with pytest.raises(InputError, match=r"claims\.npy is not a point file \(its header claims"):
+        read_cloud(path)
+
+
+def test_a_truncated_npy_is_refused_and_a_whole_one_reads(tmp_path):
+    pts = np.random.default_rng(0).uniform(0.3, 0.6, (1000, 3))
+    np.save(tmp_path / "whole.npy", pts)
+    data = (tmp_path / "whole.npy").read_bytes()
+    (tmp_path / "cut.npy").write_bytes(data[:-8])
+    assert np.array_equal(read_cloud(tmp_path / "whole.npy"), pts)
+    with pytest.raises(InputError, match="truncated or damaged"):
+        read_cloud(tmp_path / "cut.npy")
 
 
 def _cfg(table: dict) -> dict:

@@ -20,12 +20,14 @@ array (k, 3), or a text file of one point per line, ``x y z`` or ``x, y, z`` (``
 from __future__ import annotations
 
 import io
+import math
 import warnings
 from dataclasses import replace
 from pathlib import Path
 
 import coal
 import numpy as np
+from numpy.lib import format as fmt
 
 from ..errors import InputError
 from ..files import read_input
@@ -88,6 +90,25 @@ def cloud_obstacle(
     return replace(obstacle(_octree(pts, resolution, name), position, rotation, name), points=pts)
 
 
+def _load_npy(data: bytes) -> np.ndarray:
+    """The array of a ``.npy`` file's bytes, after checking that its header claims no more
+    data than the file holds (``np.load`` allocates the claimed size first: a 100-byte file
+    whose header claims 10¹¹ points asked for 2 TiB); ValueError naming what is wrong."""
+    buf = io.BytesIO(data)
+    version = np.lib.format.read_magic(buf)
+    readers = {(1, 0): fmt.read_array_header_1_0, (2, 0): fmt.read_array_header_2_0}
+    if version not in readers:  # 3.0: UTF-8 field names, never a point array
+        raise ValueError(f".npy format version {version[0]}.{version[1]}")
+    shape, _, dtype = readers[version](buf)
+    claimed, held = math.prod(shape) * dtype.itemsize, len(data) - buf.tell()
+    if claimed > held:
+        raise ValueError(
+            f"its header claims shape {shape}, {claimed:,} bytes, the file holds {held:,}: "
+            "truncated or damaged"
+        )
+    return np.load(io.BytesIO(data), allow_pickle=False)
+
+
 def read_cloud(path: Path | str, name: str = "cloud") -> np.ndarray:
     """The (k, 3) points of a ``.npy`` file or a text file of ``x y z`` / ``x, y, z`` lines (m);
     UnknownNameError for a missing file, InputError for one that holds no such points."""
@@ -95,7 +116,7 @@ def read_cloud(path: Path | str, name: str = "cloud") -> np.ndarray:
     data = read_input(path, f"{name}: point file")  # a regular file of at most 256 MiB
     try:
         if path.suffix.lower() == ".npy":
-            pts = np.load(io.BytesIO(data), allow_pickle=False)
+            pts = _load_npy(data)
         else:
             text = data.decode("utf-8-sig").replace(",", " ")  # a BOM some editors write
             with warnings.catch_warnings():  # no data: refused below, with the shape
