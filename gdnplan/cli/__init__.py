@@ -2,9 +2,10 @@
 
 Exit status: 0 success; 1 planning failed (``plan``, ``fetch``); 2 bad input (a
 :class:`~gdnplan.errors.GdnplanError`, a usage error or a standard output that cannot be written,
-e.g. ``> /dev/full``: one line ``error: …`` naming the field and the fix); 3 internal error (any other exception: one line ``error: internal error (Type: message);
-rerun with --debug for the traceback``); 130 interrupted (Ctrl-C). ``gdnplan --debug <command> …``
-prints the traceback of errors 2 and 3 as well.
+e.g. ``> /dev/full``: one line ``error: …`` naming the field and the fix); 3 internal error (any
+other exception: one line ``error: internal error (Type: message); rerun with --debug for the
+traceback``); 130 interrupted (Ctrl-C). ``gdnplan --debug <command> …`` prints the traceback of
+errors 2 and 3 as well.
 
 The command lives in a package by concern: :mod:`~gdnplan.cli.app` (the app and :func:`run`),
 :mod:`~gdnplan.cli.common` (what the commands share), :mod:`~gdnplan.cli.plan` (``show``,
