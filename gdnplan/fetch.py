@@ -19,10 +19,12 @@ retreat      q_out → q_home          holding   planned
 Planned stages use ``margin`` (m) as their clearance: a planned stage succeeds when the coal
 certificate of :func:`gdnplan.ccd.certify_path` proves d > margin on the whole continuous path
 (:attr:`gdnplan.trajopt.Plan.success`). The
-lift is certified from its second point on (tcp 2 mm above the shelf, ``certified_from`` = 1):
-its start is the contact the grasp makes by design (d = 0), where no certificate can prove a
-clearance; its ``min_distance`` is the true minimum over its whole path (0 at that contact),
-``certified_min_distance`` the proven lower bound over the certified rows.
+lift is certified clear from its second point on (tcp 2 mm above the shelf, ``certified_from``
+= 1): its start is the contact the grasp makes by design (d = 0), where no clearance can be
+proven; its first segment, and the grasp itself, are proven never to penetrate by more than
+:data:`~gdnplan.ccd_contact.CONTACT_ALLOWANCE` (:func:`gdnplan.ccd_contact.certify_from_contact`).
+Its ``min_distance`` is the smallest coal distance over its whole path (0 at that contact),
+``certified_min_distance`` the proven lower bound over the rows certified clear.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from .ccd import verify_path
+from .ccd_contact import certify_from_contact, contact_detail
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
 from .models import DistanceModel
@@ -50,10 +53,6 @@ log = logging.getLogger(__name__)  # one INFO line per finished stage
 
 STAGES = ("approach", "reach_in", "grasp", "lift", "bring_out", "retreat")
 LIFT_POINTS = 11  # IK points on the lift line, 2 mm apart
-CONTACT_SAMPLES = 50  # coal distances on the lift's first (uncertified) segment
-# the closed gripper's stick rests on its shelf (d = 0 by construction); coal's rounding gives
-# up to ≈ −4e-16 m there on some layouts, which is contact, not penetration
-RESTING_CONTACT_TOL = 1e-9  # m
 BRING_OUT_PROBLEM = "fetch_bring_out"  # the shipped problem whose planner tables bring-out uses
 
 
@@ -87,12 +86,14 @@ class Stage:
         scene: the scene the stage moves in (its robot carries the gripper state).
         q: (T, 3) joint path (rad); a single configuration repeated for ``grasp``.
         success: certified collision-free (planned stages: :class:`~gdnplan.trajopt.Plan`'s
-            success; grasp: the closed gripper holds the stick; lift: certified off the shelf).
+            success; grasp: the closed gripper holds the stick, proven not to penetrate the
+            shelf; lift: certified off the shelf).
         min_distance: the smallest coal distance along the stage's whole path q (m): the
             certificate's proven lower bound when it covers all of q (planned stages; −inf when
             it could not prove one); grasp: coal's distance at the grasp; lift: the smaller of
-            coal's distance along its uncertified first segment (sampled; 0 at the resting
-            contact) and the proven bound over the rest.
+            the smallest coal distance the contact certificate checked on its first segment
+            (0 at the resting contact; the segment proven > −CONTACT_ALLOWANCE) and the proven
+            bound over the rest.
         certified_from: the first row of q the continuous certificate covers (0: all of it;
             lift: 1), None when there is no certificate (grasp: one configuration).
         certified_min_distance: the certificate's proven lower bound over q[certified_from:]
@@ -181,24 +182,23 @@ def lift_path(scene: Scene, n: int = LIFT_POINTS) -> np.ndarray:
 
 
 def _lift(held: Scene) -> Stage:
-    """The scripted lift: rows 1… certified (proven > 0), row 0 the resting contact (coal
-    d ≥ −RESTING_CONTACT_TOL); min_distance the minimum over the whole path."""
+    """The scripted lift: rows 1… certified clear (proven > 0); the first segment, leaving the
+    resting contact at row 0, proven > −CONTACT_ALLOWANCE (:mod:`gdnplan.ccd_contact`)."""
     t0 = time.perf_counter()
     path = lift_path(held)
     ok, proven = verify_path(held, path[1:])
-    s = np.linspace(0.0, 1.0, CONTACT_SAMPLES)[:, None]
-    first = float(signed_distance(held, path[0] + s * (path[1] - path[0])).min())
-    ok = ok and first >= -RESTING_CONTACT_TOL
+    leave = certify_from_contact(held, path[:2])
     up = 1000 * LIFT / (LIFT_POINTS - 1)
     detail = (
         f"scripted vertical lift of {LIFT} m; rows 1… ({up:.0f} mm up and above) certified, "
         f"proven d ≥ {proven:.4g} m; row 0 is the stick resting on its shelf (coal d = "
         f"{float(signed_distance(held, path[0])[0]):.3g} m), the first segment "
-        f"{CONTACT_SAMPLES} coal samples, min {first:.3g} m"
+        + contact_detail(leave)
     )
     times = _scripted_times(held, path)
     dt = time.perf_counter() - t0
-    return Stage("lift", held, path, ok, min(first, proven), dt, False, detail, times, 1, proven)
+    low = min(leave.min_distance, proven)
+    return Stage("lift", held, path, ok and leave.ok, low, dt, False, detail, times, 1, proven)
 
 
 def _planned(
@@ -253,7 +253,7 @@ def run_fetch(
                     name,
                     held,
                     at_grasp,
-                    d >= -RESTING_CONTACT_TOL,
+                    certify_from_contact(held, at_grasp[:1]).ok,
                     d,
                     time.perf_counter() - t0,
                     False,

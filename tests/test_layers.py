@@ -62,6 +62,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "distance",
             "ccd",
             "ccd_curve",
+            "ccd_contact",
             "rrt",
             "ur5e",
             "ur5e.scene",
