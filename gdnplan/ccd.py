@@ -59,6 +59,7 @@ from .errors import InputError
 from .flags import check_flag
 from .limits import check_int, check_number, is_number, shown
 from .robot import Robot
+from .robot_checks import check_pairs
 from .scene import Scene, check_scene
 
 COAL_SLACK = 2 * coal.DistanceRequest().gjk_tolerance  # relative error allowance of coal (m/m)
@@ -88,7 +89,7 @@ def lever_arms(robot: Robot) -> np.ndarray:
     r_{l,j} = max_p Σ_{i=j}^{b−2} |o_{i+1} − o_i| + |p − o_{b−1}| over the vertices p of link l on
     body b > j (joints 0-indexed), and 0 where joint j is downstream of the link.
     """
-    return _lever_arms(robot)
+    return _lever_arms(check_robot(robot))
 
 
 def motion_bound(
@@ -97,8 +98,10 @@ def motion_bound(
     """Largest distance any robot point travels from qa to qb (B, dof) along the segment (m).
 
     Returns (B,) = max_l δ_l, or (B, n_links) with ``per_link``; δ_l = Σ_j r_{l,j} |Δq_j|.
+    One configuration on either side pairs with every row of the other.
     """
-    delta = np.abs(np.asarray(qb, float) - np.asarray(qa, float)) @ lever_arms(robot).T
+    check_robot(robot)
+    delta = np.abs(check_pairs(robot, qa, qb)) @ lever_arms(robot).T
     return delta if per_link else delta.max(axis=1)
 
 
@@ -156,6 +159,14 @@ def check_certify_args(
     check_int(min_splits, "min_splits", 1, MAX_SPLITS)
     check_int(max_checks, "max_checks", 1, MAX_CHECKS)
     check_flag(stop_early, "stop_early")
+
+
+def check_robot(robot: object) -> Robot:
+    """``robot`` when it is a planar :class:`~gdnplan.robot.Robot`, else InputError naming it."""
+    if not isinstance(robot, Robot):
+        hint = "; a 3-D robot: use gdnplan.arm3d" if type(robot).__name__ == "Robot3D" else ""
+        raise InputError(f"robot: expected a planar Robot, got {type(robot).__name__}{hint}")
+    return robot
 
 
 def _initial_pieces(q_path: np.ndarray, splits: int):

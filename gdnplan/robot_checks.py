@@ -50,6 +50,31 @@ def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
     return q
 
 
+def one_q(q, dof: int, name: str = "q") -> np.ndarray:
+    """One configuration as float64 (dof,): the checks of :func:`as_batch`, and one row only
+    (a (B, dof) batch is refused, not read as its first row); a float64 (dof,) array that is
+    finite passes as it is (the kinematics' per-configuration calls)."""
+    if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (dof,):
+        if np.isfinite(q).all():
+            return q
+    arr = as_batch(q, dof, name)
+    if len(arr) != 1:
+        raise InputError(f"{name}: expected one configuration ({dof},), got {len(arr)} of them")
+    return arr[0]
+
+
+def check_pairs(robot, qa, qb) -> np.ndarray:
+    """qb − qa (B, dof) of two batches of ``robot``'s configurations (``robot.check_q``: real,
+    finite, dof columns) of equal length, or one of them a single configuration; else
+    InputError naming them (numpy raised its broadcast error, or dropped a complex part)."""
+    qa, qb = robot.check_q(qa, "qa"), robot.check_q(qb, "qb")
+    if len(qa) != len(qb) and 1 not in (len(qa), len(qb)):
+        raise InputError(
+            f"qa, qb: expected as many configurations on each side, got {len(qa)} and {len(qb)}"
+        )
+    return qb - qa
+
+
 def _needs_grad(q) -> bool:
     return bool(getattr(q, "requires_grad", False))
 
@@ -85,4 +110,4 @@ def make_rng(seed, name: str = "seed") -> np.random.Generator:
     return np.random.default_rng(check_seed(seed, name))
 
 
-__all__ = ["as_batch", "check_seed", "first_outside", "make_rng"]
+__all__ = ["as_batch", "check_pairs", "check_seed", "first_outside", "make_rng", "one_q"]

@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gdnplan.arm3d import Scene3D, box_obstacle, checker3d, load_robot3d, random_boxes
-from gdnplan.arm3d.ccd3d import certify_path3d, lever_arms3d
+from gdnplan.arm3d.ccd3d import certify_path3d, lever_arms3d, motion_bound3d
 from gdnplan.errors import InputError
 
 HOME = np.array([0.0, -1.57, 1.57, -1.57, -1.57, 0.0])
@@ -66,3 +66,31 @@ def test_certificate_input_errors():
         certify_path3d(scene, np.stack([HOME, HOME]), margin=-1.0)
     with pytest.raises(InputError, match=r"^stop_early: expected True or False, got 'no'$"):
         certify_path3d(scene, np.stack([HOME, HOME]), stop_early="no")
+
+
+@pytest.mark.parametrize(
+    ("robot", "qa", "qb", "message"),
+    [
+        ("ur5e", HOME[None], HOME[None, :5], r"^qb: expected shape \(B, 6\)"),  # broadcast error
+        ("ur5e", HOME + 1j, HOME, r"^qa: expected real numbers"),  # imaginary part dropped
+        ("ur5e", HOME * np.nan, HOME, r"^qa: contains NaN"),  # a NaN bound
+        ("ur5e", np.stack([HOME] * 3), np.stack([HOME] * 2), r"^qa, qb: expected as many"),
+        (None, HOME, HOME, r"^robot: expected a Robot3D, got NoneType"),  # AttributeError
+        ("planar2", HOME, HOME, r"^robot: expected a Robot3D, got Robot; a planar Robot"),
+    ],
+)
+def test_motion_bounds_check_robot_and_configurations(robot, qa, qb, message):
+    import gdnplan as gp
+
+    robot = {"ur5e": load_robot3d("ur5e"), "planar2": gp.load_robot("planar2")}.get(robot)
+    with pytest.raises(InputError, match=message):
+        motion_bound3d(robot, qa, qb)
+    if robot is None or robot.name == "planar2":
+        with pytest.raises(InputError, match=message):
+            lever_arms3d(robot)
+
+
+def test_one_configuration_pairs_with_a_batch():
+    robot = load_robot3d("ur5e")
+    batch = HOME + np.linspace(0, 0.1, 4)[:, None]
+    assert np.allclose(motion_bound3d(robot, HOME, batch), motion_bound3d(robot, batch, HOME))

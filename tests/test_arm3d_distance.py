@@ -151,3 +151,39 @@ def test_a_batch_of_any_size_has_the_shapes_of_its_rows(batch, per_link, gradien
     assert d.shape == (batch, *tail)
     for i in range(batch):
         assert np.array_equal(d[i], signed_distance3d(scene, q[i], per_link=per_link)[0])
+
+
+@pytest.mark.parametrize("tolerance", [-1.0, 0.0, np.nan, 1e300, True, "x", [1e-6]])
+def test_a_checker_tolerance_outside_its_range_is_refused(ur5e_scene, tolerance):
+    """A negative or NaN GJK/EPA tolerance made every distance 0, a string raised Boost's
+    ArgumentError, a list TypeError (unhashable) in the checker cache."""
+    from gdnplan.arm3d import checker3d
+
+    with pytest.raises(InputError, match=r"^tolerance: expected None or a number in \(0, 0.01\]"):
+        checker3d(ur5e_scene, tolerance)
+
+
+@pytest.mark.parametrize("value", [10**400, -(10**400)], ids=["+huge int", "-huge int"])
+def test_cap_and_contact_offset_refuse_ints_past_the_float_range(ur5e_scene, value):
+    q = np.zeros((1, 6))
+    with pytest.raises(InputError, match=r"^cap: expected a number \(m\) or inf"):
+        signed_distance3d(ur5e_scene, q, cap=value)
+    with pytest.raises(InputError, match=r"^contact_offset: expected a number \(m\) or inf"):
+        Coal3DModel(contact_offset=value)
+
+
+@pytest.mark.parametrize(
+    ("robot", "size", "message"),
+    [
+        ("ur5e", (0.1, 0.2, 5.0), r"^size: expected \[smallest, largest\]"),  # 5.0 was ignored
+        ("ur5e", (0.1,), r"^size: expected \[smallest, largest\]"),  # IndexError
+        ("ur5e", {0.1, 0.2}, r"^size: expected \[smallest, largest\]"),  # TypeError
+        ("planar2", (0.05, 0.2), r"^robot: expected a Robot3D, got Robot"),  # AttributeError
+    ],
+)
+def test_random_boxes_check_robot_and_size(robot, size, message):
+    import gdnplan as gp
+
+    robot = load_robot3d(robot) if robot == "ur5e" else gp.load_robot(robot)
+    with pytest.raises(InputError, match=message):
+        random_boxes(robot, 3, size=size)

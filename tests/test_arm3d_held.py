@@ -123,3 +123,19 @@ def test_bad_holds_are_input_errors(held):
     bad[:3, :3] = np.diag([1, 1, -1])
     with pytest.raises(InputError, match="rotation"):
         hold(ur5e3d(), box((0.1, 0.1, 0.1)), bad)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        ({"placement": "x"}, r"^placement: expected a \(4, 4\) transform, got 'x'"),  # ValueError
+        ({"placement": np.eye(4) + 0.5j}, r"^placement: expected a \(4, 4\) transform"),  # cast
+        ({"placement": [[1, 0], [0]]}, r"^placement: expected a \(4, 4\) transform"),
+        ({"name": 3}, r"^name: expected the held object's name \(a string\), got 3"),
+        ({"robot": None}, r"^robot: expected a Robot3D, got NoneType"),  # AttributeError
+    ],
+)
+def test_hostile_hold_arguments_are_input_errors(args, message):
+    robot = args.pop("robot", ur5e3d())
+    with pytest.raises(InputError, match=message):
+        hold(robot, box((0.1, 0.1, 0.1)), **args)

@@ -101,6 +101,59 @@ def test_bad_configurations_are_one_line_input_errors(q, match):
     assert "\n" not in str(e.value)
 
 
+HOSTILE_Q = st.one_of(
+    st.sampled_from(
+        [
+            [0.0] * 5,
+            [0.1] * 6 + [0.0],
+            np.zeros((2, 6)),
+            np.zeros((1, 6, 1)),
+            np.full(6, 0.1 + 1j),
+            np.full(6, np.nan),
+            np.full(6, True),
+            "abcdef",
+            [[0.1] * 6, [0.1] * 5],
+            np.zeros(6, dtype=object),
+        ]
+    ),
+    st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=6, max_size=6),
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(q=HOSTILE_Q, method=st.sampled_from(["body_placements", "shape_placements",
+                                            "joint_jacobians"]))  # fmt: skip
+def test_kinematics_of_one_configuration_check_it(q, method):
+    """Pinocchio raised its own ValueError or ArgumentError for a wrong size or a batch, numpy
+    dropped a complex q's imaginary part and NaN gave NaN placements: now InputError naming q,
+    or finite placements of one real configuration."""
+    robot = load_robot3d("ur5e")
+    try:
+        out = getattr(robot, method)(q)
+    except InputError as e:
+        assert str(e).startswith("q: ")
+        return
+    arrays = out if isinstance(out, tuple) else (out,)
+    assert all(np.isfinite(a).all() for a in arrays)
+    assert np.asarray(q).dtype.kind in "if" and np.asarray(q).size == 6
+
+
+def test_point_jacobian_and_sampling_check_their_arguments():
+    robot, q = load_robot3d("ur5e"), np.zeros(6)
+    with pytest.raises(InputError, match=r"^body: expected an integer in \[0, 6\], got 99"):
+        robot.point_jacobian(q, 99, [0.0, 0.0, 0.0])
+    with pytest.raises(InputError, match=r"^point: expected shape \(B, 3\)"):
+        robot.point_jacobian(q, 1, [0.0, 0.0])
+    with pytest.raises(InputError, match=r"^n: expected an integer in \[0, 100000000\]"):
+        robot.random_configurations(-1, np.random.default_rng(0))
+    with pytest.raises(InputError, match=r"^rng: expected a numpy.random.Generator, got int"):
+        robot.random_configurations(3, 0)
+    with pytest.raises(InputError, match=r"^tol: expected a finite number ≥ 0, got nan"):
+        robot.within_limits(q, tol=np.nan)  # every configuration was "outside"
+    with pytest.raises(InputError, match=r"^urdf: expected a file path, got int"):
+        robot3d_from_urdf(3)
+
+
 URDF = """<robot name="r">
   <link name="a"><collision><geometry>{geometry}</geometry></collision></link>
   <link name="b"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>

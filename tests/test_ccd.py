@@ -201,3 +201,22 @@ def test_a_scene_without_obstacles_is_certified_at_once(tol, min_splits):
     empty = gp.make_scene("a").with_obstacles([])
     cert = certify_path(empty, np.array([[0.0, 0.0], [0.5, 0.5]]), tol=tol, min_splits=min_splits)
     assert cert.ok and cert.lower_bound == np.inf and cert.n_checks == min_splits + 1
+
+
+@pytest.mark.parametrize(
+    ("qa", "qb", "message"),
+    [
+        (np.zeros((1, 2)), np.zeros((1, 3)), r"^qb: expected shape \(B, 2\)"),
+        (np.zeros(2) + 1j, np.zeros(2), r"^qa: expected real numbers"),
+        (np.zeros((3, 2)), np.zeros((2, 2)), r"^qa, qb: expected as many configurations"),
+    ],
+)
+def test_motion_bound_checks_its_configurations(qa, qb, message):
+    """numpy raised its broadcast error or dropped the imaginary part of a complex q."""
+    from gdnplan.ccd import lever_arms, motion_bound
+
+    robot = gp.load_robot("planar2")
+    with pytest.raises(InputError, match=message):
+        motion_bound(robot, qa, qb)
+    with pytest.raises(InputError, match=r"^robot: expected a planar Robot, got str"):
+        lever_arms("planar2")

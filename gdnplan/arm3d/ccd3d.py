@@ -58,10 +58,11 @@ import numpy as np
 
 from ..ccd import Certificate, certify_by_bisection, check_certify_args
 from ..errors import InputError
+from ..robot_checks import check_pairs
 from ..scene import check_scene
 from .distance3d import checker3d
 from .robot3d import Robot3D
-from .scene3d import Scene3D
+from .scene3d import Scene3D, check_robot3d
 
 
 @dataclass(frozen=True)
@@ -90,6 +91,7 @@ def lever_arms3d(robot: Robot3D) -> np.ndarray:
     for a revolute joint, 1 for a prismatic one (:func:`_lever_arms3d`); computed once per
     robot (the certificate asks for them on every bisection round). InputError for a joint
     kind without a proven bound (:func:`joint_kind`)."""
+    check_robot3d(robot)
     if robot not in _ARMS:
         arms = _lever_arms3d(robot)
         arms.setflags(write=False)
@@ -168,8 +170,9 @@ def self_pair_arms(robot: Robot3D) -> np.ndarray:
 
 
 def motion_bound3d(robot: Robot3D, qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
-    """(B,) bound Δ on the change of any pair's distance from qa to qb (B, dof) (m)."""
-    step = np.abs(np.asarray(qb, float) - np.asarray(qa, float))
+    """(B,) bound Δ on the change of any pair's distance from qa to qb (B, dof) (m); one
+    configuration on either side pairs with every row of the other."""
+    step = np.abs(check_pairs(check_robot3d(robot), qa, qb))
     out = (step @ lever_arms3d(robot).T).max(axis=1)  # obstacle pairs: max_σ δ_σ
     if len(robot.self_pairs):
         out = np.maximum(out, (step @ self_pair_arms(robot).T).max(axis=1))

@@ -34,7 +34,7 @@ import numpy as np
 from ..flags import check_flag
 from ..scene import check_scene
 from .gradient3d import pair_gradients
-from .narrow3d import PairTable, check_cap, check_offset
+from .narrow3d import PairTable, check_cap, check_offset, check_tolerance
 from .scene3d import Scene3D
 
 
@@ -202,6 +202,7 @@ _CHECKERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 def checker3d(scene: Scene3D, tolerance: float | None = None) -> Checker3D:
     """The cached :class:`Checker3D` of a scene (one per tolerance)."""
     check_scene(scene, "3d", "gdnplan.distance.checker")
+    tolerance = check_tolerance(tolerance)  # before the cache: a list is no dictionary key
     per_scene = _CHECKERS.setdefault(scene, {})
     if tolerance not in per_scene:
         per_scene[tolerance] = Checker3D(scene, tolerance)

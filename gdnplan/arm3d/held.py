@@ -22,9 +22,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..limits import shown
 from ..ur5e.gripper import FINGER_LENGTH, GRASP_GAP
 from .ik3d import tool_frame
 from .robot3d import LinkShape, Robot3D
+from .scene3d import check_robot3d
 from .shapes import as_pose, bounding_sphere, box, check_shape
 
 HELD_LINK = "held_object"  # the link name of the held object's shape
@@ -56,13 +58,22 @@ def hold(
     ``held_placement`` (the (4, 4) placement in that frame). InputError
     when the robot already holds an object or the frame is unknown.
     """
+    check_robot3d(robot)
+    if not isinstance(name, str):
+        raise InputError(f"name: expected the held object's name (a string), got {shown(name)}")
     if HELD_LINK in robot.links:
         raise InputError(f"hold: {robot.name} already holds {robot.info.get('held')!r}")
     frame = tool_frame(robot) if frame is None else frame
     model = robot.model
     if not isinstance(frame, str) or not model.existFrame(frame):
         raise InputError(f"frame: {frame!r} is not a frame of {robot.name}")
-    tf = np.eye(4) if placement is None else np.asarray(placement, dtype=float)
+    try:
+        tf = np.eye(4) if placement is None else np.asarray(placement)
+    except ValueError as e:  # ragged rows
+        raise InputError(f"placement: expected a (4, 4) transform, got {shown(placement)}") from e
+    if tf.dtype.kind not in "iuf":  # a string, complex numbers (cast silently), objects
+        raise InputError(f"placement: expected a (4, 4) transform, got {shown(placement)}")
+    tf = tf.astype(float)
     if tf.shape != (4, 4) or not np.all(np.isfinite(tf)) or not np.allclose(tf[3], [0, 0, 0, 1]):
         raise InputError("placement: expected a (4, 4) homogeneous transform of finite numbers")
     as_pose(tf[:3, 3], tf[:3, :3], "placement")  # validates the rotation

@@ -47,6 +47,7 @@ import coal
 import numpy as np
 
 from ..errors import InputError
+from ..limits import is_number, shown
 from .fk3d import shape_placements_batch
 from .scene3d import Scene3D
 
@@ -99,6 +100,7 @@ class PairTable:
         ]
         self.request = coal.DistanceRequest()
         self.request.enable_signed_distance = True
+        tolerance = check_tolerance(tolerance)
         if tolerance is not None:
             self.request.gjk_tolerance = tolerance
             self.request.epa_tolerance = tolerance
@@ -208,29 +210,53 @@ def swept_radius(shape) -> float:
     return core + float(own)
 
 
+MAX_TOLERANCE = 1e-2  # GJK/EPA tolerance: beyond it a "distance" is off by centimetres
+
+
+def check_tolerance(tolerance) -> float | None:
+    """``tolerance`` (None: coal's default) as a float in (0, :data:`MAX_TOLERANCE`], else
+    InputError (a negative or NaN tolerance made every distance 0, a string raised Boost's
+    ArgumentError)."""
+    if tolerance is None:
+        return None
+    if not (is_number(tolerance) and 0 < tolerance <= MAX_TOLERANCE):
+        raise InputError(
+            f"tolerance: expected None or a number in (0, {MAX_TOLERANCE:g}] (coal's GJK/EPA "
+            f"tolerance; default 1e-6), got {shown(tolerance)}"
+        )
+    return float(tolerance)
+
+
 def check_cap(cap) -> float:
     """``cap`` as a float (m; inf allowed), InputError when it is not a number or NaN."""
     try:
         value = float(cap)
-    except (TypeError, ValueError) as e:
-        raise InputError(f"cap: expected a number (m) or inf, got {cap!r}") from e
+    except (TypeError, ValueError, OverflowError) as e:  # OverflowError: an int past 1e308
+        raise InputError(f"cap: expected a number (m) or inf, got {shown(cap)}") from e
     if np.isnan(value) or isinstance(cap, bool):
-        raise InputError(f"cap: expected a number (m) or inf, got {cap!r}")
+        raise InputError(f"cap: expected a number (m) or inf, got {shown(cap)}")
     return value
 
 
 def check_offset(contact_offset) -> float:
     """``contact_offset`` as a float (m; +inf allowed), InputError for NaN, −inf or a non-number."""
-    bad = InputError(f"contact_offset: expected a number (m) or inf, got {contact_offset!r}")
+    bad = InputError(f"contact_offset: expected a number (m) or inf, got {shown(contact_offset)}")
     if isinstance(contact_offset, bool):
         raise bad
     try:
         value = float(contact_offset)
-    except (TypeError, ValueError) as e:
+    except (TypeError, ValueError, OverflowError) as e:
         raise bad from e
     if np.isnan(value) or value == -np.inf:
         raise bad
     return value
 
 
-__all__ = ["PairTable", "check_cap", "check_offset", "swept_radius"]
+__all__ = [
+    "MAX_TOLERANCE",
+    "PairTable",
+    "check_cap",
+    "check_offset",
+    "check_tolerance",
+    "swept_radius",
+]

@@ -27,10 +27,12 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
-from ..robot import as_batch
+from ..limits import check_int, check_number
+from ..robot import MAX_SAMPLES, as_batch
+from ..robot_checks import one_q
 from ..urdf_robot import RobotSpec, load_urdf
 from ..urdf_robot.joint_limits import check_joint_limits
-from ..urdf_robot.load import check_mimic
+from ..urdf_robot.load import check_mimic, urdf_path
 from ..urdf_robot.locking import lock_mimics, set_locked
 from ..urdf_robot.spec import check_folders, check_locked, check_names
 from .pairs import contact_only_mask, self_collision_pairs
@@ -127,18 +129,23 @@ class Robot3D:
         return as_batch(q, self.dof, name)
 
     def within_limits(self, q, tol: float = 1e-9) -> np.ndarray:
-        """(B,) True where every joint is within its limits."""
-        q = self.check_q(q)
+        """(B,) True where every joint is within its limits (widened by ``tol`` ≥ 0)."""
+        q, tol = self.check_q(q), check_number(tol, "tol")
         return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=1)
 
     def random_configurations(self, n: int, rng: np.random.Generator) -> np.ndarray:
-        """(n, dof) configurations drawn uniformly within the joint limits."""
+        """(n, dof) configurations drawn uniformly within the joint limits (n ≤ 10⁸)."""
+        check_int(n, "n", 0, MAX_SAMPLES)
+        if not isinstance(rng, np.random.Generator):
+            raise InputError(f"rng: expected a numpy.random.Generator, got {type(rng).__name__}")
         return rng.uniform(self.lower, self.upper, size=(n, self.dof))
 
     # ---------------------------------------------------------------- kinematics
+    # (each takes one configuration (dof,), checked by one_q: Pinocchio raised its own errors
+    # for a wrong size, and numpy dropped a complex q's imaginary part)
     def body_placements(self, q: np.ndarray) -> np.ndarray:
         """(njoints, 4, 4) world placements of every body's joint frame at one q (dof,)."""
-        pin.forwardKinematics(self.model, self.data, np.asarray(q, dtype=float))
+        pin.forwardKinematics(self.model, self.data, one_q(q, self.dof))
         return np.array([m.homogeneous for m in self.data.oMi])
 
     def shape_placements(self, q: np.ndarray) -> np.ndarray:
@@ -150,8 +157,7 @@ class Robot3D:
     def joint_jacobians(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every body's joint Jacobian (njoints, 6, dof), LOCAL_WORLD_ALIGNED ([v; ω] of the
         joint origin in world axes), and the joint origins (njoints, 3) in m, at one q (dof,)."""
-        q = np.asarray(q, dtype=float)
-        pin.computeJointJacobians(self.model, self.data, q)
+        pin.computeJointJacobians(self.model, self.data, one_q(q, self.dof))
         frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
         jac = np.array(
             [
@@ -163,9 +169,12 @@ class Robot3D:
         return jac, origins
 
     def point_jacobian(self, q: np.ndarray, body: int, point: np.ndarray) -> np.ndarray:
-        """(3, dof) Jacobian ∂p/∂q of a world point (3,) fixed on ``body`` at one q (dof,)."""
+        """(3, dof) Jacobian ∂p/∂q of a world point (3,) fixed on ``body`` (a joint index,
+        0 … njoints − 1) at one q (dof,)."""
+        body = check_int(body, "body", 0, self.model.njoints - 1)
+        point = one_q(point, 3, "point")
         jac, origins = self.joint_jacobians(q)
-        return point_jacobians(jac[body][None], origins[body][None], np.asarray(point)[None])[0]
+        return point_jacobians(jac[body][None], origins[body][None], point[None])[0]
 
 
 def point_jacobians(jac: np.ndarray, origins: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -210,7 +219,7 @@ def robot3d_from_urdf(
         InputError: a URDF that does not parse, invalid geometry (flat, NaN, huge), joints out
             of order, a locked value outside its limits.
     """
-    path = Path(urdf)
+    path = urdf_path(urdf)
     dirs = check_folders(package_dirs)
     if joints is not None:
         joints = check_names(joints, "joints", "joint names")

@@ -20,7 +20,7 @@ import coal
 import numpy as np
 
 from ..errors import InputError
-from ..limits import check_int, check_number, is_number
+from ..limits import check_int, check_number, is_number, shown
 from ..robot import Robot, check_seed
 from .robot3d import Robot3D
 from .shapes import (
@@ -128,13 +128,21 @@ def mesh_obstacle(path, position=(0, 0, 0), rotation=None, scale=(1, 1, 1), name
     return obstacle(load_mesh(path, scale, name), position, rotation, name)
 
 
+def check_robot3d(robot: object) -> Robot3D:
+    """``robot`` when it is a :class:`Robot3D`, else InputError naming it (a planar Robot, None
+    or a name raised AttributeError deep inside the 3-D functions that take a robot)."""
+    if not isinstance(robot, Robot3D):
+        hint = "; a planar Robot belongs in gdnplan.Scene" if isinstance(robot, Robot) else ""
+        hint = "; build it with gdnplan.arm3d.load_robot3d" if isinstance(robot, str) else hint
+        raise InputError(f"robot: expected a Robot3D, got {type(robot).__name__}{hint}")
+    return robot
+
+
 class Scene3D:
     """A 3-D robot and its obstacles (a sequence of :class:`Obstacle3D`)."""
 
     def __init__(self, robot: Robot3D, obstacles: Sequence[Obstacle3D] = ()):
-        if not isinstance(robot, Robot3D):
-            hint = "; a planar Robot belongs in gdnplan.Scene" if isinstance(robot, Robot) else ""
-            raise InputError(f"robot: expected a Robot3D, got {type(robot).__name__}{hint}")
+        check_robot3d(robot)
         if isinstance(obstacles, Scene3D):
             raise InputError("obstacles: got a Scene3D; pass its obstacles (scene.obstacles)")
         if not isinstance(obstacles, (list, tuple)):
@@ -157,6 +165,7 @@ class Scene3D:
 def workspace_radius(robot: Robot3D, samples: int = 256, seed: int = 0) -> float:
     """Radius (m) around the base origin that encloses every link shape's bounding sphere at
     ``samples`` random configurations (an estimate of the arm's reach)."""
+    check_robot3d(robot)
     check_int(samples, "samples", 1, 10**6)
     rng = np.random.default_rng(check_seed(seed))
     centers = np.array([s.center for s in robot.shapes])
@@ -179,8 +188,11 @@ def random_boxes(
     """N random axis-aligned boxes in the arm's workspace: centres uniform in the upper half
     of the ball of radius :func:`workspace_radius` (z ≥ 0), sides uniform in ``size`` (m),
     centres farther than ``base_clearance`` (m) from the base's vertical axis."""
+    check_robot3d(robot)
     check_int(n, "n", 0, MAX_OBSTACLES)
     check_seed(seed)
+    if not isinstance(size, (list, tuple, np.ndarray)) or len(size) != 2:  # 3 were cut to 2
+        raise InputError(f"size: expected [smallest, largest] side (m), got {shown(size)}")
     lo = check_number(size[0], "size[0]", 0.0, strict=True)
     hi = check_number(size[1], "size[1]", lo)
     clearance = check_number(base_clearance, "base_clearance")

@@ -10,6 +10,7 @@ limits are checked by :mod:`~gdnplan.urdf_robot.joint_limits`.
 
 from __future__ import annotations
 
+import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -28,6 +29,14 @@ AXIS_UNIT_TOLERANCE = 1e-9  # largest | |axis| − 1 | of a joint axis after Pin
 __all__ = ["MAX_OFFSET", "check_mimic", "load_urdf", "stderr_captured"]
 
 
+def urdf_path(urdf: object) -> Path:
+    """``urdf`` as a Path when it is a str or path-like, else InputError (Path(3) raised
+    TypeError)."""
+    if not isinstance(urdf, (str, os.PathLike)):
+        raise InputError(f"urdf: expected a file path, got {type(urdf).__name__}")
+    return Path(urdf)
+
+
 def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     """Pinocchio model and collision geometry of ``spec.urdf``.
 
@@ -39,7 +48,7 @@ def load_urdf(spec: RobotSpec) -> tuple[pin.Model, pin.GeometryModel]:
     joint and the attribute), and for a planning joint that is a ``<mimic>`` joint or is
     mimicked (:func:`check_mimic`).
     """
-    path = Path(spec.urdf)
+    path = urdf_path(spec.urdf)
     try:
         found = path.is_file()
     except (OSError, ValueError):  # a name too long, a NUL byte
