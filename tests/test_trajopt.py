@@ -144,6 +144,39 @@ def test_adam_stops_on_a_non_finite_step(square, config):
     assert np.all(np.isfinite(result.q)) and not result.success
 
 
+class _Shaped:
+    """A caller's model returning ``out(q)`` for the distances and gradients."""
+
+    name = "shaped"
+
+    def __init__(self, out):
+        self.out = out
+
+    def distance(self, scene, q):
+        return self.out(q)[0]
+
+    def distance_and_grad(self, scene, q):
+        return self.out(q)
+
+
+@pytest.mark.parametrize(
+    ("out", "what"),
+    [
+        (lambda q: (np.zeros(3), np.zeros((3, 3))), r"distance returned .* shape \(3,\)"),
+        (lambda q: (np.zeros(len(q)) + 1j, np.zeros(q.shape)), "distance returned .*complex"),
+        (lambda q: (["0.1"] * len(q), np.zeros(q.shape)), "distance returned .*<U3"),
+        (lambda q: (np.zeros(len(q)), np.zeros(len(q))), "gradients returned .* shape \\(2,\\)"),
+    ],
+    ids=["wrong length", "complex", "strings", "flat gradient"],
+)
+def test_a_callers_model_of_the_wrong_outputs_is_named_before_the_solver(square, out, what):
+    """numpy raised its broadcast or ufunc error deep inside the solver (ipopt.py), a complex
+    model lost its imaginary part silently."""
+    p = Problem(scene=square, start=START, goal=GOAL, waypoints=10)
+    with pytest.raises(gp.InputError, match=rf"^collision: model 'shaped': .*{what}"):
+        plan(p, collision=_Shaped(out))
+
+
 class Underestimating:
     """A learned stand-in: coal's distance minus 0.25 m (rates the whole problem too close)."""
 
@@ -341,7 +374,8 @@ def test_each_restart_adds_a_check_point_per_segment(square):
     opts = PlanConfig(SeedConfig(initial="rrt", starts=3), RefineConfig(rounds=0, **SEEDS_ONLY))
     result = plan(p, collision=model, solver=opts)
     assert not result.success and result.attempts == 3
-    batches = list(dict.fromkeys(model.sizes))  # distinct NLP sizes, in order
+    assert model.sizes[0] == 2  # plan's probe of the model's outputs (planner.check_outputs)
+    batches = list(dict.fromkeys(model.sizes[1:]))  # distinct NLP sizes, in order
     assert batches[:3] == [(p.waypoints - 1) * (m + 1) - 1 for m in (2, 3, 4)]
 
 

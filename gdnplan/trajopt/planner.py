@@ -61,7 +61,7 @@ def resolve_model(
                 f"collision: expected 'coal', 'graphdistnet' or a DistanceModel, "
                 f"got {type(collision).__name__}"
             )
-        return checked(collision, scene)
+        return check_outputs(checked(collision, scene), scene)
     if collision == "coal":
         return Coal3DModel() if isinstance(scene, Scene3D) else CoalModel()
     if collision != "graphdistnet":
@@ -85,6 +85,42 @@ def checked(model: DistanceModel, scene: Scene) -> DistanceModel:
     check = getattr(model, "check_scene", None)
     if check is not None:
         check(scene)
+    return model
+
+
+def check_outputs(model: DistanceModel, scene: Scene | Scene3D) -> DistanceModel:
+    """``model`` when its ``distance`` and ``distance_and_grad`` return real distances (B,) and
+    gradients (B, dof) for a batch of B = 2 configurations (the middle of the joint limits and
+    the lower limits), else InputError naming the model and the method: a caller's model of
+    the wrong shapes or of strings failed deep inside the solver with numpy's broadcast or
+    ufunc errors, a complex one lost its imaginary part. NaN values pass (the solver treats
+    them as an invalid trial point)."""
+    robot = scene.robot
+    q = np.stack([(robot.lower + robot.upper) / 2, robot.lower])
+    q = np.where(np.isfinite(q), q, 0.0)
+    name = getattr(model, "name", type(model).__name__)
+    d = model.distance(scene, q)
+    try:
+        d2, g = model.distance_and_grad(scene, q)
+    except (TypeError, ValueError) as e:  # not a pair
+        raise InputError(
+            f"collision: model {name!r}: distance_and_grad must return (distances, gradients)"
+        ) from e
+    for what, value, shape in (
+        ("distance", d, (2,)),
+        ("distance_and_grad's distances", d2, (2,)),
+        ("distance_and_grad's gradients", g, (2, robot.dof)),
+    ):
+        try:
+            arr = np.asarray(value)
+        except (TypeError, ValueError):  # ragged rows
+            arr = np.asarray(None)
+        if arr.dtype.kind not in "iuf" or arr.shape != shape:
+            got = f"an array of {arr.dtype} of shape {arr.shape}"
+            raise InputError(
+                f"collision: model {name!r}: {what} returned {got} for 2 configurations; "
+                f"expected real numbers of shape {shape} (see gdnplan.DistanceModel)"
+            )
     return model
 
 
