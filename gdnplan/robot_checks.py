@@ -23,7 +23,8 @@ _KINDS = {"b": "booleans", "U": "strings", "S": "bytes", "c": "complex numbers",
 
 
 def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
-    """Return q as a float64 (B, dof) array; a single (dof,) configuration becomes (1, dof).
+    """Return q as a C-contiguous float64 (B, dof) array; a single (dof,) configuration becomes
+    (1, dof) (a view of a negative-stride or Fortran-order q was refused by torch.as_tensor).
 
     InputError naming ``name`` unless q holds real numbers (numpy kinds integer, unsigned or
     float): booleans, strings, complex numbers and other objects are refused, not coerced
@@ -44,7 +45,7 @@ def as_batch(q, dof: int, name: str = "q") -> np.ndarray:
         raise InputError(f"{name}: expected real numbers (rad), got {what}")
     if arr.ndim not in (1, 2) or arr.shape[-1] != dof:
         raise InputError(f"{name}: expected shape (B, {dof}) or ({dof},), got {arr.shape}")
-    q = arr.astype(float, copy=False).reshape(-1, dof)
+    q = np.ascontiguousarray(arr, dtype=float).reshape(-1, dof)  # torch takes no negative strides
     if not np.all(np.isfinite(q)):
         raise InputError(f"{name}: contains NaN or infinite values")
     return q

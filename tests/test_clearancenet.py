@@ -25,3 +25,17 @@ def test_vertex_vector_layout_for_alpha_shapes():
     assert v.shape == (1, 5 * 15 * 2)
     first = scene.obstacles[0]
     np.testing.assert_allclose(v[0, : 2 * len(first)], first.ravel())
+
+
+def test_views_of_any_stride_give_the_distances_of_a_copy():
+    """torch.as_tensor refused a negative-stride q (ValueError from ClearanceNet's inference);
+    the shared q check (robot_checks.as_batch) now returns a C-contiguous array."""
+    scene = gp.make_scene("d", seed=3)
+    q = scene.robot.sample(6, seed=0)
+    for name in ("clearancenet_d", "d"):
+        model = gp.load_model(name)
+        for view in (q[::-1, ::-1], q[::2], np.asfortranarray(q)):
+            d, g = model.distance_and_grad(scene, view)
+            d_copy, g_copy = model.distance_and_grad(scene, view.copy())
+            np.testing.assert_array_equal(d, d_copy)
+            np.testing.assert_array_equal(g, g_copy)

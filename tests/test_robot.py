@@ -1,5 +1,7 @@
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 import gdnplan as gp
 from gdnplan.robot import as_batch
@@ -100,3 +102,20 @@ def test_unknown_robot_names_choices():
 def test_sample_refuses_a_count_that_is_not_a_sane_integer(n):
     with pytest.raises(gp.InputError, match="n:"):
         gp.load_robot("planar2").sample(n)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    rows=st.integers(1, 6),
+    step=st.sampled_from([1, -1, 2, -2]),
+    order=st.sampled_from(["C", "F"]),
+    dtype=st.sampled_from([np.float64, np.float32, np.int16]),
+)
+@example(rows=3, step=-1, order="C", dtype=np.float64)
+def test_as_batch_returns_c_contiguous_copies_of_views(rows, step, order, dtype):
+    """A negative-stride view passed through as a view, which torch.as_tensor refused."""
+    base = np.asarray(np.arange(rows * 2 * 4).reshape(rows * 2, 4), dtype=dtype, order=order)
+    view = base[::step, ::-1] if step < 0 else base[::step]
+    out = as_batch(view, 4)
+    assert out.flags.c_contiguous and out.dtype == np.float64
+    np.testing.assert_array_equal(out, view.astype(float))
