@@ -119,3 +119,11 @@ def test_an_unknown_key_names_the_closest_allowed_one(tmp_path, table, typo, mea
     path.write_text(text if header in text else f"{text}\n{header}{typo} = 1\n")
     with pytest.raises(ProblemFileError, match=rf"\['{typo}'\] \(did you mean '{meant}'\?\)"):
         Problem.from_toml(path)
+
+
+def test_a_byte_order_mark_is_read(tmp_path):
+    """A problem file saved with a UTF-8 byte-order mark (Windows editors) was refused as
+    'malformed TOML: Invalid statement (at line 1, column 1)'."""
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + SQUARE.read_bytes())
+    assert Problem.from_toml(path).start.tolist() == Problem.from_toml(SQUARE).start.tolist()

@@ -48,15 +48,18 @@ HOME["interpolated"] = "ipopt] or [adam"  # in both
 
 
 def read_problem_file(path: str | Path) -> dict:
-    """The parsed TOML mapping of a problem file; ProblemFileError when it cannot be read, is
-    no regular file of at most ``MAX_INPUT_BYTES`` (:func:`gdnplan.files.read_input`), is
-    not UTF-8 text, is malformed or nests deeper than Python's parser can follow.
+    """The parsed TOML mapping of a problem file (UTF-8, with or without a byte-order mark);
+    ProblemFileError when it cannot be read, is no regular file of at most
+    ``MAX_INPUT_BYTES`` (:func:`gdnplan.files.read_input`), is not UTF-8 text, is malformed,
+    holds an integer too long to read or nests deeper than Python's parser can follow.
 
     ``path``: a file, or the name of a shipped problem (``"fetch_reach"``).
     """
     path = problem_file(path)
     try:
-        return tomllib.loads(read_input(path, "problem file").decode("utf-8"))
+        # utf-8-sig: a byte-order mark (Windows editors write one) is read, not refused as
+        # "Invalid statement (at line 1, column 1)", as in point files
+        return tomllib.loads(read_input(path, "problem file").decode("utf-8-sig"))
     except InputError as e:  # missing, a directory, a FIFO or device, larger than 256 MiB
         raise ProblemFileError(str(e)) from e
     except UnicodeDecodeError as e:
