@@ -25,7 +25,7 @@ from .errors import InputError
 from .limits import check_int
 from .planar_chain import PlanarChain, cross_z, rot2
 from .registry import ROBOTS
-from .robot_checks import as_batch, check_seed, first_outside, make_rng
+from .robot_checks import as_batch, check_joint_range, check_seed, first_outside, make_rng
 
 MAX_SAMPLES = 10**8  # configurations of one Robot.sample call
 
@@ -93,6 +93,11 @@ class Robot:
     upper: np.ndarray
     base_radius: float = 0.15
     info: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        lower, upper = check_joint_range(self.lower, self.upper, self.model.nq, "joint limits")
+        object.__setattr__(self, "lower", lower)
+        object.__setattr__(self, "upper", upper)
 
     # ---------------------------------------------------------------- structure
     @property

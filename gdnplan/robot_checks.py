@@ -76,6 +76,33 @@ def check_pairs(robot, qa, qb) -> np.ndarray:
     return qb - qa
 
 
+MAX_JOINT_LIMIT = 1e3  # rad: |lower|, |upper| of a robot's joint (as a URDF's, joint_limits)
+
+
+def check_joint_range(lower, upper, dof: int, name: str = "limits") -> tuple:
+    """(lower, upper) as read-only float64 (dof,) arrays of finite real numbers within
+    ±:data:`MAX_JOINT_LIMIT` rad with lower < upper, else InputError naming ``name`` (a
+    robot built with limits of another joint count, reversed, NaN or complex ones was
+    accepted and planned with them)."""
+    out = []
+    for which, value in (("lower", lower), ("upper", upper)):
+        arr = as_batch(value, dof, f"{name} {which}")
+        if len(arr) != 1 or np.max(np.abs(arr)) > MAX_JOINT_LIMIT:
+            raise InputError(
+                f"{name} {which}: expected {dof} joint limits within ±{MAX_JOINT_LIMIT:g} rad"
+            )
+        arr = arr[0].copy()
+        arr.setflags(write=False)
+        out.append(arr)
+    bad = np.flatnonzero(out[0] >= out[1])
+    if bad.size:
+        j = int(bad[0])
+        raise InputError(
+            f"{name}: joint {j} has lower {out[0][j]:g} ≥ upper {out[1][j]:g}; give lower < upper"
+        )
+    return tuple(out)
+
+
 def _needs_grad(q) -> bool:
     return bool(getattr(q, "requires_grad", False))
 
@@ -111,4 +138,13 @@ def make_rng(seed, name: str = "seed") -> np.random.Generator:
     return np.random.default_rng(check_seed(seed, name))
 
 
-__all__ = ["as_batch", "check_pairs", "check_seed", "first_outside", "make_rng", "one_q"]
+__all__ = [
+    "MAX_JOINT_LIMIT",
+    "as_batch",
+    "check_joint_range",
+    "check_pairs",
+    "check_seed",
+    "first_outside",
+    "make_rng",
+    "one_q",
+]

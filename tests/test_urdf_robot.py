@@ -634,3 +634,31 @@ def test_geometry_points_span_a_hull_containing_the_shape(kind):
     faces = ConvexHull(geometry_points(shape)).equations  # n · x + c ≤ 0 inside
     surface = _dense_surface(kind, r, length, n=2000)
     assert np.max(surface @ faces[:, :3].T + faces[:, 3]) <= 1e-12
+
+
+_LIMITS_URDF = (
+    Path(__file__).resolve().parent.parent / "gdnplan" / "shipped" / "robots" / "planar2.urdf"
+)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"limits": (np.zeros(3), np.ones(3))}, r"^joint limits lower: expected shape \(B, 2\)"),
+        ({"limits": (np.ones(2), np.zeros(2))}, r"^joint limits: joint 0 has lower 1 ≥ upper 0"),
+        ({"limits": (np.full(2, np.nan), np.ones(2))}, r"^joint limits lower: contains NaN"),
+        ({"limits": (np.full(2, -1 + 1j), np.ones(2))}, r"^joint limits lower: expected real"),
+        ({"limits": "x"}, r"^limits: expected \(lower, upper\) joint limits, got 'x'"),
+        ({"spec": {"urdf": "x"}}, r"^spec: expected a gdnplan.RobotSpec, got dict"),
+        ({"extra_polygons": "abc"}, r"^extra_polygons: expected a list of \(name, frame"),
+        ({"skip_geometry": 3}, r"^skip_geometry: expected a function"),
+        ({"info": [1]}, r"^info: expected a dict or None, got \[1\]"),
+    ],
+    ids=["3 limits", "reversed", "NaN", "complex", "str", "spec dict", "extras", "skip", "info"],
+)
+def test_hostile_robot_from_urdf_arguments_are_input_errors(kwargs, message):
+    """Limits of another joint count, reversed, NaN or complex were accepted (the robot then
+    planned with them); the others raised TypeError, ValueError or AttributeError."""
+    spec = kwargs.pop("spec", gp.RobotSpec(urdf=_LIMITS_URDF, planning_joints=("joint1", "joint2")))
+    with pytest.raises(gp.InputError, match=message):
+        gp.robot_from_urdf("arm", spec, **kwargs)

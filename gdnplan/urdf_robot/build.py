@@ -9,6 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
+from ..limits import shown
 from ..robot import LinkPolygon, Plane, Robot, apply_se3, robot_names
 from .checks import _check_axes, _check_chain, _check_options, _reference_configuration, plane_basis
 from .load import load_urdf
@@ -43,6 +44,9 @@ def robot_from_urdf(
     """
     if not isinstance(name, str) or not name.strip():
         raise InputError(f"name: expected a robot name, got {name!r}")
+    if not isinstance(spec, RobotSpec):  # a dict raised AttributeError
+        raise InputError(f"spec: expected a gdnplan.RobotSpec, got {type(spec).__name__}")
+    _check_extras(extra_polygons, skip_geometry, info)
     if name in robot_names():
         raise InputError(
             f"name: {name!r} is a shipped robot's name (learned weights are matched by robot "
@@ -113,8 +117,12 @@ def robot_from_models(
             "give link polygons"
         )
 
-    lower = reduced.lowerPositionLimit.copy() if limits is None else np.asarray(limits[0], float)
-    upper = reduced.upperPositionLimit.copy() if limits is None else np.asarray(limits[1], float)
+    if limits is None:
+        lower, upper = reduced.lowerPositionLimit.copy(), reduced.upperPositionLimit.copy()
+    elif isinstance(limits, (tuple, list)) and len(limits) == 2:
+        lower, upper = limits  # Robot checks them (robot_checks.check_joint_range)
+    else:
+        raise InputError(f"limits: expected (lower, upper) joint limits, got {shown(limits)}")
     return Robot(
         name=name,
         model=reduced,
@@ -125,6 +133,25 @@ def robot_from_models(
         base_radius=spec.base_radius,
         info=dict(info or {}, urdf=str(spec.urdf)),
     )
+
+
+def _check_extras(extra_polygons, skip_geometry, info) -> None:
+    """InputError unless ``extra_polygons`` is a list of (name, frame, vertices) triples,
+    ``skip_geometry`` callable and ``info`` a dict or None (each raised its own TypeError or
+    ValueError from inside the build)."""
+    if not isinstance(extra_polygons, (list, tuple)) or not all(
+        isinstance(e, (list, tuple)) and len(e) == 3 for e in extra_polygons
+    ):
+        raise InputError(
+            "extra_polygons: expected a list of (name, frame, vertices (m, 2)) triples, got "
+            f"{shown(extra_polygons)}"
+        )
+    if not callable(skip_geometry):
+        raise InputError(
+            f"skip_geometry: expected a function name -> bool, got {shown(skip_geometry)}"
+        )
+    if info is not None and not isinstance(info, dict):
+        raise InputError(f"info: expected a dict or None, got {shown(info)}")
 
 
 def _attach(model, data, plane: Plane, name: str, frame: int, uv: np.ndarray) -> LinkPolygon:
