@@ -33,6 +33,7 @@ def test_grasp_and_lift_are_scripted_and_certified(canonical):
     assert grasp.success and not grasp.planned and abs(grasp.min_distance) < 1e-6
     assert lift.success and abs(lift.min_distance) <= 1e-9  # it starts resting on the shelf
     assert lift.certified_from == 1 and lift.certified_min_distance > 0
+    assert "first segment proven never to penetrate by 10 µm" in lift.detail  # not sampled
     assert np.allclose(lift.q[0], canonical.q["q_grasp"])
     assert np.allclose(lift.q[-1], canonical.q["q_lift"])
 

@@ -25,9 +25,11 @@ Planned stages are :class:`gdnplan.trajopt.Problem` s on the stage's Scene3D wit
 coal certificate (:func:`gdnplan.arm3d.certify_path3d`) proves d > margin on its whole
 continuous path (obstacles and self-collision, the held stick included), a stage when every
 piece does (the pieces share their ends, so the stage's path is certified). The lift starts at
-the stick's resting contact (d = 0), where no certificate proves a clearance: its
-``min_distance`` is the true minimum over its whole path (0 there), ``certified_min_distance``
-the proven lower bound over rows ``certified_from`` = 1 on.
+the stick's resting contact (d = 0), where no certificate proves a clearance: its first
+segment, and the grasp, are proven never to penetrate by more than
+:data:`~gdnplan.ccd_contact.CONTACT_ALLOWANCE` (:func:`gdnplan.ccd_contact.certify_from_contact`);
+its ``min_distance`` is the smallest coal distance over its whole path (0 there),
+``certified_min_distance`` the proven lower bound over rows ``certified_from`` = 1 on.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..ccd_contact import certify_from_contact, contact_detail
 from ..errors import InputError
 from ..trajopt import PlanConfig, Problem, plan
 from ..trajopt.config import SeedConfig
@@ -58,8 +61,6 @@ PLANNED = {  # stage → (scene, start, goal)
     "bring_out": ("holding", "q_lift", "q_out"),
     "retreat": ("holding", "q_out", "q_home"),
 }
-RESTING_CONTACT_TOL = 1e-9  # m: the stick on its shelf is contact, not penetration
-CONTACT_SAMPLES = 50  # coal distances on the lift's first (uncertified) segment
 WAYPOINTS = 30
 KNOT_STEP = 10  # points of a straight tool line (LINE_STEP = 0.01 m apart) between knots
 MARGIN = 0.01  # m: clearance of the planned stages
@@ -83,9 +84,9 @@ class Stage3D:
             shelf without penetration; lift: certified off the shelf).
         min_distance: the smallest coal distance along the whole path q (m): the proven lower
             bound when the certificate covers all of q (planned; −inf when none was proven);
-            grasp: coal's distance at q_grasp; lift: the smaller of coal's distance along its
-            uncertified first segment (sampled; 0 at the resting contact) and the proven bound
-            over the rest.
+            grasp: coal's distance at q_grasp; lift: the smaller of the smallest coal distance
+            the contact certificate checked on its first segment (0 at the resting contact; the
+            segment proven > −CONTACT_ALLOWANCE) and the proven bound over the rest.
         solve_time: wall time of the stage (s). planned: solved by :func:`plan`.
         detail: the planner's reason or what the scripted stage did.
         certified_from: the first row of q the certificate covers (0: all; lift: 1), None
@@ -192,7 +193,7 @@ def _grasp(fetch: Fetch3D) -> Stage3D:
         f"its shelf (d = {d:.4f} m)"
     )
     q = np.array([fetch.q["q_grasp"]] * 2)
-    ok = d >= -RESTING_CONTACT_TOL
+    ok = certify_from_contact(scene, q[:1]).ok
     dt = time.perf_counter() - t0
     return Stage3D("grasp", "holding", scene, q, ok, d, dt, False, detail, None)
 
@@ -202,17 +203,16 @@ def _lift(fetch: Fetch3D) -> Stage3D:
     scene, path = fetch.scenes["holding"], fetch.lines["lift"]
     cert = certify_path3d(scene, path[1:], margin=0.0)
     lower = cert.lower_bound if cert.ok else -np.inf
-    s = np.linspace(0.0, 1.0, CONTACT_SAMPLES)[:, None]
-    first = checker3d(scene).evaluate(path[0] + s * (path[1] - path[0])).distance
-    ok = cert.ok and float(first.min()) >= -RESTING_CONTACT_TOL
+    leave = certify_from_contact(scene, path[:2])
+    ok = cert.ok and leave.ok
+    resting = float(checker3d(scene).evaluate(path[0]).distance[0])
     detail = (
         f"scripted straight lift; rows 1… ({1000 * LIFT / (len(path) - 1):.0f} mm up and above) "
         f"certified, proven d ≥ {lower:.4g} m; row 0 is the stick resting on its shelf (coal "
-        f"d = {first[0]:.3g} m), the first segment {CONTACT_SAMPLES} coal samples, min "
-        f"{first.min():.3g} m"
+        f"d = {resting:.3g} m), the first segment " + contact_detail(leave)
     )
     dt = time.perf_counter() - t0
-    low = min(float(first.min()), lower)
+    low = min(leave.min_distance, lower)
     return Stage3D("lift", "holding", scene, path, ok, low, dt, False, detail, 1, lower)
 
 
