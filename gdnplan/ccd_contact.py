@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from .ccd import Certificate, certify_by_bisection
+from .ccd import MAX_CHECKS, MAX_SPLITS, Certificate, certify_by_bisection
 from .errors import InputError
 from .exact import exact_distance, motion_bound_of, swept_radius_of
 from .limits import check_int, check_number
@@ -70,8 +70,8 @@ def certify_from_contact(
             f"allowance: expected at most {MAX_ALLOWANCE} m of penetration (a contact), got "
             f"{allowance}; prove a clearance with certify_path instead"
         )
-    check_int(min_splits, "min_splits", 1, 10_000)
-    check_int(max_checks, "max_checks", 1, 10**8)
+    check_int(min_splits, "min_splits", 1, MAX_SPLITS)
+    check_int(max_checks, "max_checks", 1, MAX_CHECKS)
     robot = scene.robot
     q_path = robot.check_q(q_path, "q_path")
     if not len(q_path):
