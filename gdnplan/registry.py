@@ -13,9 +13,10 @@ declared module. ``import gdnplan`` thus builds no robot and imports no pinocchi
 from __future__ import annotations
 
 import importlib
+import inspect
 from collections.abc import Callable
 
-from .errors import UnknownNameError, did_you_mean
+from .errors import InputError, UnknownNameError, did_you_mean
 
 
 class Registry:
@@ -51,6 +52,11 @@ class Registry:
 
     def get(self, name: str) -> Callable:
         """The factory of ``name``; UnknownNameError listing the names when there is none."""
+        if not isinstance(name, str):  # a list is no dictionary key (TypeError)
+            raise UnknownNameError(
+                f"{self.kind}: expected a name, got {type(name).__name__}; choose one of "
+                f"{self.names()}"
+            )
         if name not in self.factories and name in self.builtins:
             importlib.import_module(self.builtins[name])
         if name not in self.factories:
@@ -59,6 +65,28 @@ class Registry:
                 f"choose one of {self.names()}"
             )
         return self.factories[name]
+
+    def build(self, name: str, fixed: tuple[str, ...] = (), **options):
+        """``factory(**options)`` of ``name``, after checking the option names: one the factory
+        does not take is an InputError naming it and the ones it takes (Python's TypeError
+        "unexpected keyword argument" before); ``fixed`` names options the caller always
+        passes (``seed``), not listed as choices."""
+        factory = self.get(name)
+        allowed = options_of(factory) - set(fixed)
+        unknown = sorted(set(options) - allowed - set(fixed))
+        if unknown:
+            takes = f"it takes {sorted(allowed)}" if allowed else "it takes none"
+            raise InputError(
+                f"{self.kind} {name!r}: unknown option(s) {unknown}"
+                f"{did_you_mean(unknown[0], allowed)}; {takes}"
+            )
+        return factory(**options)
+
+
+def options_of(factory: Callable) -> set[str]:
+    """Names of the parameters of ``factory`` that can be given by keyword."""
+    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    return {p.name for p in inspect.signature(factory).parameters.values() if p.kind in kinds}
 
 
 ROBOTS = Registry("robot")

@@ -13,7 +13,6 @@ shipped ones.
 
 from __future__ import annotations
 
-import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -24,7 +23,7 @@ import pinocchio as pin
 from .errors import InputError
 from .limits import check_int
 from .planar_chain import PlanarChain, cross_z, rot2
-from .registry import ROBOTS
+from .registry import ROBOTS, options_of
 from .robot_checks import as_batch, check_joint_range, check_seed, first_outside, make_rng
 
 MAX_SAMPLES = 10**8  # configurations of one Robot.sample call
@@ -287,10 +286,7 @@ def robot_options(name: str) -> set[str]:
     return factory_options(ROBOTS.get(name))
 
 
-def factory_options(factory: Callable) -> set[str]:
-    """Names of the parameters of ``factory`` that can be given by keyword."""
-    kinds = (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
-    return {p.name for p in inspect.signature(factory).parameters.values() if p.kind in kinds}
+factory_options = options_of  # names of a factory's keyword parameters (registry.options_of)
 
 
 def load_robot(name: str, **options) -> Robot:
@@ -299,9 +295,9 @@ def load_robot(name: str, **options) -> Robot:
     Options are passed to the factory (e.g. ``gripper="holding", stick_length=0.3`` for ur5e).
     Results without options are cached: the same name returns the same object.
     """
-    factory = ROBOTS.get(name)
-    if options:
-        return factory(**options)
+    if options:  # an option the factory does not take: InputError (registry.build)
+        return ROBOTS.build(name, **options)
+    factory = ROBOTS.get(name)  # first: a name that is no string is an UnknownNameError
     if name not in _CACHE:
         _CACHE[name] = factory()
     return _CACHE[name]

@@ -141,7 +141,7 @@ def scene_options(name: str) -> set[str]:
 def make_scene(name: str, seed: int = 0, **options) -> Scene:
     """Build the scene ``name`` (``"a"`` … ``"e"``, ``"fetch"``) with a seed (an integer ≥ 0)."""
     check_int(seed, "seed", 0)
-    return SCENES.get(name)(seed=seed, **options)
+    return SCENES.build(name, ("seed",), seed=seed, **options)
 
 
 ENV_ROBOT = {"a": "planar2", "b": "planar2", "c": "planar7", "d": "planar7", "e": "planar7"}

@@ -130,3 +130,26 @@ def test_scene_rejects_a_thin_sliver_before_coal_sees_it():
 def test_scene_config_errors_are_problem_file_errors(cfg, field):
     with pytest.raises(gp.ProblemFileError, match=field):
         scene_mod.scene_from_config(cfg)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda: gp.make_scene("d", n=5), r"^scene 'd': unknown option\(s\) \['n'\]; it takes no"),
+        (
+            lambda: gp.make_scene("fetch", griper="open"),
+            r"^scene 'fetch': unknown option\(s\) \['griper'\] \(did you mean 'gripper'\?\)",
+        ),
+        (
+            lambda: gp.load_robot("ur5e", stick_lenght=0.3),
+            r"^robot 'ur5e': unknown option\(s\) \['stick_lenght'\] \(did you mean 'stick_length",
+        ),
+        (lambda: gp.load_robot(["planar2"]), r"^robot: expected a name, got list"),
+        (lambda: gp.make_scene({"a": 1}), r"^scene: expected a name, got dict"),
+    ],
+    ids=["no options", "scene typo", "robot typo", "robot list", "scene dict"],
+)
+def test_unknown_factory_options_and_unhashable_names_are_gdnplan_errors(build, message):
+    """Python raised TypeError ("unexpected keyword argument", "unhashable type: 'list'")."""
+    with pytest.raises(gp.GdnplanError, match=message):
+        build()
