@@ -281,3 +281,18 @@ def test_a_robot3d_is_immutable_once_built():
         with pytest.raises(ValueError, match="read-only"):
             array[0] = array[0]
     assert load_robot3d("ur5e") is robot and robot.lower.flags.writeable is False
+
+
+def test_names_and_paths_of_the_wrong_kind_are_gdnplan_errors():
+    """A list name raised TypeError (unhashable), an int path TypeError (Path(3)), tool_frame
+    of None AttributeError."""
+    from gdnplan.arm3d import mesh_obstacle, read_cloud, tool_frame
+
+    with pytest.raises(UnknownNameError, match=r"^robot: unknown 3-D robot \['ur5e'\]"):
+        load_robot3d(["ur5e"])
+    with pytest.raises(InputError, match=r"^robot: expected a Robot3D, got NoneType"):
+        tool_frame(None)
+    with pytest.raises(InputError, match=r"^cloud: point file: expected a file path, got int"):
+        read_cloud(3)
+    with pytest.raises(InputError, match=r"^mesh: mesh file: expected a file path, got int"):
+        mesh_obstacle(3)

@@ -85,7 +85,7 @@ def load_robot3d(name: str) -> Robot3D:
 
     The returned robot is shared: treat it as read-only (its Pinocchio data is scratch space).
     """
-    if name not in FACTORIES:
+    if not isinstance(name, str) or name not in FACTORIES:  # a list raised TypeError
         raise UnknownNameError(
             f"robot: unknown 3-D robot {shown(name)}{did_you_mean(name, FACTORIES)}; choose one "
             f"of {list(FACTORIES)}"

@@ -37,7 +37,7 @@ from ..robot_checks import make_rng
 from .distance3d import checker3d
 from .ik3d_checks import MAX_POINTS, MIN_TOL, check_ik_settings, check_positions
 from .robot3d import Robot3D
-from .scene3d import Scene3D
+from .scene3d import Scene3D, check_robot3d
 from .shapes import as_rotation, as_vector
 
 TOOL_FRAMES = {"ur5e": "gripper_tcp", "panda": "panda_hand_tcp", "ur5": "tool0"}
@@ -71,6 +71,7 @@ class PoseIK:
 def tool_frame(robot: Robot3D) -> str:
     """The name of the robot's tool frame: ``robot.info["tool_frame"]``, else the built-in's
     (:data:`TOOL_FRAMES`), else the last frame of the model."""
+    check_robot3d(robot)
     name = robot.info.get("tool_frame") or TOOL_FRAMES.get(robot.name)
     return name if name is not None else robot.model.frames[len(robot.model.frames) - 1].name
 

@@ -23,6 +23,7 @@ determinant +1).
 from __future__ import annotations
 
 import logging
+import os
 from pathlib import Path
 
 import coal
@@ -227,7 +228,10 @@ def _deepest_inside(pts: np.ndarray, hull: ConvexHull) -> float:
 
 
 def existing_file(path, what: str) -> Path:
-    """``path`` as a Path, UnknownNameError "<what> <path> does not exist" unless it is a file."""
+    """``path`` as a Path, UnknownNameError "<what> <path> does not exist" unless it is a file
+    (InputError when it is no str or path-like: Path(3) raised TypeError)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"{what}: expected a file path, got {type(path).__name__}")
     path = Path(path)
     try:
         found = path.is_file()
