@@ -127,3 +127,16 @@ def test_a_byte_order_mark_is_read(tmp_path):
     path = tmp_path / "bom.toml"
     path.write_bytes(b"\xef\xbb\xbf" + SQUARE.read_bytes())
     assert Problem.from_toml(path).start.tolist() == Problem.from_toml(SQUARE).start.tolist()
+
+
+@pytest.mark.parametrize(
+    ("cfg", "base_dir", "message"),
+    [
+        (None, None, r"^problem: expected a table of tables .*got NoneType"),  # TypeError
+        ([], None, r"^problem: expected a table of tables .*got list"),  # "[start]: missing"
+        ({}, 3, r"^base_dir: expected a folder path, got int"),
+    ],
+)
+def test_from_config_of_no_mapping_or_a_bad_base_dir(cfg, base_dir, message):
+    with pytest.raises(ProblemFileError, match=message):
+        Problem.from_config(cfg, base_dir=base_dir)

@@ -9,6 +9,7 @@ and the CLI's ``show`` both use it. ``docs/problem_file.md`` documents every key
 
 from __future__ import annotations
 
+import os
 import tomllib
 import warnings
 from dataclasses import dataclass
@@ -90,6 +91,12 @@ def problem_tables(cfg: dict, base_dir=None, require_goal: bool = True) -> Probl
     as ``gdnplan show`` draws). A file with a ``[scene3d]`` table is a 3-D problem
     (:func:`gdnplan.arm3d.scene_file3d.scene3d_from_config`). ProblemFileError names any bad
     field."""
+    if not isinstance(cfg, dict):  # None raised TypeError, a list "[start]: missing table"
+        raise ProblemFileError(
+            f"problem: expected a table of tables (a parsed TOML file), got {type(cfg).__name__}"
+        )
+    if base_dir is not None and not isinstance(base_dir, (str, os.PathLike)):
+        raise ProblemFileError(f"base_dir: expected a folder path, got {type(base_dir).__name__}")
     three_d = "scene3d" in cfg
     _no_unknown(cfg, TOP_KEYS_3D if three_d else TOP_KEYS, "top level")
     goal_keys = GOAL_KEYS_3D if three_d else GOAL_KEYS
