@@ -12,7 +12,15 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from gdnplan.arm3d import box_obstacle, mesh_obstacle
-from gdnplan.arm3d.shapes import as_pose, as_rotation, box, convex, is_convex_mesh, load_mesh
+from gdnplan.arm3d.shapes import (
+    as_pose,
+    as_rotation,
+    box,
+    convex,
+    is_convex_mesh,
+    load_mesh,
+    mesh_hull,
+)
 from gdnplan.errors import InputError, UnknownNameError
 
 CUBE = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T * 0.1
@@ -274,3 +282,59 @@ def test_an_obstacle_sphere_must_enclose_its_shape(center, radius):
     hand = Obstacle3D("hand", good.shape, good.pose, center, radius)
     d = signed_distance3d(Scene3D(robot, [hand]), q)
     assert d == pytest.approx(signed_distance3d(Scene3D(robot, [good]), q), abs=1e-9)
+
+
+def _fibonacci_sphere(n: int, radius: float = 0.1) -> np.ndarray:
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    phi = np.pi * (1.0 + 5.0**0.5) * k
+    ring = np.sqrt(1.0 - z**2)
+    return radius * np.stack([ring * np.cos(phi), ring * np.sin(phi), z], 1)
+
+
+def test_a_dense_mesh_hull_is_checked_for_convexity_in_bounded_memory():
+    """The convexity check measured every (facet, vertex) pair at once: 6 GB for a
+    20 000-vertex sphere, a MemoryError (or the OOM killer) beyond; now blocks of
+    DEPTH_BLOCK entries, and hull vertices (depth 0) are not measured."""
+    import tracemalloc
+
+    points = _fibonacci_sphere(5000)  # ~10 000 facets: the old check allocated 400 MB
+    tracemalloc.start()
+    try:
+        is_convex = is_convex_mesh(points)
+        mesh_hull(points, "dense")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert is_convex and peak < 120e6
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    st.integers(20, 300),
+    st.floats(0.0, 0.09),
+    st.integers(0, 40),
+    st.integers(0, 2**16),
+)
+@example(200, 0.05, 40, 0)
+def test_the_blocked_convexity_check_agrees_with_every_facet_and_vertex(n, depth, k, seed):
+    """is_convex_mesh = no vertex deeper than CONVEX_TOLERANCE · diameter inside the hull,
+    computed here on the full (facets, points) array."""
+    from scipy.spatial import ConvexHull
+
+    from gdnplan.arm3d import shapes
+
+    rng = np.random.default_rng(seed)
+    inner = rng.normal(size=(k, 3))
+    inner *= (0.1 - depth) / np.maximum(np.linalg.norm(inner, axis=1), 1e-9)[:, None]
+    points = np.concatenate([_fibonacci_sphere(n), inner])
+    hull = ConvexHull(points)
+    offsets = hull.equations[:, :3] @ points.T + hull.equations[:, 3:]
+    deepest = float(np.max(-np.max(offsets, axis=0)))
+    tol = shapes.CONVEX_TOLERANCE * float(np.linalg.norm(points.max(0) - points.min(0)))
+    old_block = shapes.DEPTH_BLOCK
+    try:
+        shapes.DEPTH_BLOCK = 7 * len(hull.equations)  # several blocks of 7 points
+        assert is_convex_mesh(points) == (deepest <= tol)
+    finally:
+        shapes.DEPTH_BLOCK = old_block
