@@ -21,6 +21,10 @@ from .robot import Robot
 
 MAX_OBSTACLES = 1000  # obstacle polygons of one scene
 MAX_PARTS = 500  # convex parts of all obstacles (coal's cost grows with them)
+# vertices of all obstacles: a distance call's cost grows with them (coal's support function
+# scans a part's vertices): 500 polygons of 2 000 took 14 s per configuration, 10 of 2 000
+# 0.16 s (docs/decisions.md#scene-vertex-limit)
+MAX_SCENE_VERTICES = 20_000
 
 
 def coordinate_bound(robot: Robot) -> float:
@@ -50,32 +54,42 @@ def check_obstacles(obstacles, robot: Robot) -> tuple[np.ndarray, ...]:
     """``obstacles`` as a tuple of checked CCW polygons (:func:`gdnplan.geometry.as_polygon`):
     at most :data:`MAX_OBSTACLES` of them, every vertex within :func:`coordinate_bound` of the
     robot's joint 1, every convex part passing :func:`gdnplan.geometry.check_part`, at most
-    :data:`MAX_PARTS` parts in all; else InputError naming the obstacle."""
+    :data:`MAX_PARTS` parts and :data:`MAX_SCENE_VERTICES` vertices in all; else InputError
+    naming the obstacle (checked one obstacle at a time: the first past a limit stops)."""
     if not isinstance(obstacles, (list, tuple, np.ndarray)):
         got = describe(obstacles)
         raise InputError(f"obstacles: expected a list of (m, 2) polygons, got {got}")
     if len(obstacles) > MAX_OBSTACLES:
         raise InputError(f"obstacles: {len(obstacles)} polygons, the limit is {MAX_OBSTACLES}")
-    checked = tuple(as_polygon(p, f"obstacles[{i}]") for i, p in enumerate(obstacles))
     bound = coordinate_bound(robot)
     base = robot.chain.joint_origins[0]
-    parts = 0
-    for i, poly in enumerate(checked):
+    checked, parts, vertices = [], 0, 0
+    for i, raw in enumerate(obstacles):  # one at a time: the first past a limit stops the work
+        poly = as_polygon(raw, f"obstacles[{i}]")
+        vertices += len(poly)
+        if vertices > MAX_SCENE_VERTICES:
+            raise InputError(
+                f"obstacles: more than {MAX_SCENE_VERTICES} vertices by obstacles[{i}] "
+                f"({vertices} so far), the limit (every distance call scans them); simplify "
+                "the polygons"
+            )
         far = float(np.max(np.abs(poly - base)))
         if far > bound:
             raise InputError(
                 f"obstacles[{i}]: a vertex is {far:.3g} m from the robot's base, the limit "
                 f"is {bound:.3g} m (max(100 m, 100 × reach)); remove or move the obstacle"
             )
-        for part in convex_decomposition(poly):
+        pieces = convex_decomposition(poly)
+        parts += len(pieces)
+        if parts > MAX_PARTS:  # before their checks (1000 star polygons took minutes)
+            raise InputError(
+                f"obstacles: more than {MAX_PARTS} convex parts by obstacles[{i}] ({parts} so "
+                "far), the limit; use fewer or simpler (less non-convex) obstacles"
+            )
+        for part in pieces:
             check_part(part, f"obstacles[{i}]")
-            parts += 1
-    if parts > MAX_PARTS:
-        raise InputError(
-            f"obstacles: {parts} convex parts, the limit is {MAX_PARTS}; "
-            "use fewer or simpler (less non-convex) obstacles"
-        )
-    return checked
+        checked.append(poly)
+    return tuple(checked)
 
 
 def no_unknown_keys(table: dict, allowed: Set[str], where: str) -> None:
@@ -102,6 +116,7 @@ def call_reporting(where: str, factory: Callable, *args, **options):
 __all__ = [
     "MAX_OBSTACLES",
     "MAX_PARTS",
+    "MAX_SCENE_VERTICES",
     "call_reporting",
     "check_obstacles",
     "check_robot",

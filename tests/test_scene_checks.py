@@ -246,3 +246,33 @@ def test_masked_entries_and_grad_tensors_are_refused_not_read(mask, grad):
             gp.signed_distance_and_grad(PLANAR, tensor)
     else:
         np.testing.assert_array_equal(as_batch(tensor, 2), data)
+
+
+def _circle(cx: float, cy: float, n: int, r: float = 0.03) -> np.ndarray:
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.c_[cx + r * np.cos(t), cy + r * np.sin(t)]
+
+
+def test_a_scene_past_the_vertex_limit_is_refused_at_the_obstacle_that_passes_it():
+    """500 polygons of 2 000 vertices were accepted, then each distance call took 14 s."""
+    from gdnplan.scene_checks import MAX_SCENE_VERTICES
+
+    scene = gp.make_scene("a")
+    circles = [_circle(1.5 + 0.1 * (i % 30), 1.5 + 0.1 * (i // 30), 2000) for i in range(500)]
+    k = MAX_SCENE_VERTICES // 2000
+    with pytest.raises(
+        gp.InputError, match=rf"^obstacles: more than 20000 vertices by obstacles\[{k}\]"
+    ):
+        scene.with_obstacles(circles)
+    assert len(scene.with_obstacles(circles[:k]).obstacles) == k
+
+
+def test_a_scene_past_the_part_limit_stops_at_the_first_obstacle_past_it():
+    """The parts of every obstacle were computed before the count (1 000 stars: minutes)."""
+    t = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    r = np.where(np.arange(2000) % 2 == 0, 0.05, 0.02)
+    star = np.c_[1.5 + r * np.cos(t), 1.5 + r * np.sin(t)]
+    with pytest.raises(
+        gp.InputError, match=r"^obstacles: more than 500 convex parts by obstacles\[0\]"
+    ):
+        gp.make_scene("a").with_obstacles([star] * 10)
