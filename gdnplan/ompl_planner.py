@@ -89,8 +89,21 @@ def _seed(ou, seed: int) -> None:
         _SEEDED.append(int(seed))
 
 
-def _setup(ob, scene: Scene, lower: np.ndarray, upper: np.ndarray, clearance: float):
-    """SpaceInformation over the joint box with the certified state and motion checks."""
+def _setup(
+    ob,
+    scene: Scene,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    clearance: float,
+    deadline: float = math.inf,
+):
+    """SpaceInformation over the joint box with the certified state and motion checks; a
+    motion checked after ``deadline`` (``time.perf_counter()`` s) is refused unchecked.
+
+    OMPL's path simplifier runs every step once whatever its time limit, each with many
+    motion checks (a 3-D certificate each): a 1 s plan took 4 s. Refusing motions past the
+    deadline ends them at once, and leaves the path unchanged (a refused motion is never
+    taken), so it stays as certified as it was."""
     dof = scene.robot.dof
     space = ob.RealVectorStateSpace(dof)
     bounds = ob.RealVectorBounds(dof)
@@ -113,6 +126,8 @@ def _setup(ob, scene: Scene, lower: np.ndarray, upper: np.ndarray, clearance: fl
 
     class CertifiedMotion(ob.MotionValidator):
         def checkMotion(self, a, b) -> bool:  # OMPL's name
+            if time.perf_counter() > deadline:
+                return False
             return edge_free(scene, vector(a), vector(b), clearance)
 
     si.setStateValidityChecker(valid)
@@ -193,7 +208,8 @@ def plan_ompl(
     upper: np.ndarray | None = None,
 ) -> OmplResult:
     """Plan start → goal (dof,) with OMPL's ``planner`` within ``time_limit`` (s of wall time:
-    set-up, planning and simplification together).
+    set-up, planning and simplification together, up to the motion check under way; no
+    motion is checked, so none is added to the path, after it).
 
     ``simplify``: OMPL's ``PathSimplifier`` (vertex reduction, shortcuts, B-spline smoothing,
     every change checked by the certified motion validator) runs afterwards in the time left;
@@ -217,7 +233,7 @@ def plan_ompl(
     ou.setLogLevel(ou.LOG_ERROR)
     _seed(ou, seed)
     t0 = time.perf_counter()
-    si, _, vector = _setup(ob, scene, lower, upper, clearance)
+    si, _, vector = _setup(ob, scene, lower, upper, clearance, t0 + float(time_limit))
     ss = og.SimpleSetup(si)
     a, b = si.allocState(), si.allocState()
     for j in range(scene.robot.dof):

@@ -43,3 +43,34 @@ def test_ompl_states_hold_contact_only_pairs_at_zero():
         for j, value in enumerate(q):
             state[j] = float(value)
         assert si.isValid(state) is valid
+
+
+def test_ompl_honours_its_time_limit_in_3d(monkeypatch):
+    """OMPL's path simplifier ran every step once whatever the time left, each with many
+    certified motion checks: a 0.05 s plan took 0.8 s, a 3 s one 6.4 s. Past the time limit
+    motions are refused unchecked; the path (certified motion by motion) is kept as it was."""
+    import time
+
+    import gdnplan.ompl_planner as op
+
+    scene = Scene3D(load_robot3d("ur5e"), [box_obstacle((0.1, 0.1, 0.6), (0.45, 0.0, 0.3))])
+    real_edge_free, real_certify, called = op.edge_free, op.certify, []
+
+    def slow_edge_free(*args):
+        time.sleep(0.03)  # a costly certificate, whatever the machine's load
+        return real_edge_free(*args)
+
+    def timed_certify(*args, **kwargs):
+        called.append(time.perf_counter())
+        return real_certify(*args, **kwargs)
+
+    monkeypatch.setattr(op, "edge_free", slow_edge_free)
+    monkeypatch.setattr(op, "certify", timed_certify)
+    lower, upper = np.full(6, -np.pi), np.full(6, np.pi)
+    t0 = time.perf_counter()
+    result = plan_ompl(scene, START, GOAL, 0.02, time_limit=0.5, lower=lower, upper=upper)
+    if not called:  # no path within the limit: it returned at once
+        assert not result.success and time.perf_counter() - t0 < 0.5 + 0.5
+        return
+    assert called[0] - t0 < 0.5 + 0.5  # one motion check under way at most
+    assert not result.success or certify_path3d(scene, result.path, 0.02).ok
