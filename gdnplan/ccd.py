@@ -41,7 +41,11 @@ configuration: both ends of its zero-length piece), the result is
 ``ok=False`` with ``n_checks=0`` and the reason, nothing evaluated or allocated; ``n_checks``
 never exceeds ``max_checks`` and ``ok`` always comes with ``reason == ""``. Pieces are also
 bisected until their bound is within ``tol`` of the smallest checked distance, so the
-reported lower bound is at most ``tol`` below the path's true minimum.
+reported lower bound is at most ``tol`` below the path's true minimum — while the budget
+lasts: when the next round would exceed it, the pieces already proven above the margin keep
+their looser bound and only the others are bisected further, for the margin alone (a path
+proven at the margin is never failed for want of a tight bound: a 40-joint arm's straight
+line, proven with ``tol = inf``, failed the planner's final ``tol = 1e-3`` certificate).
 """
 
 from __future__ import annotations
@@ -124,7 +128,8 @@ class Certificate:
     """Result of :func:`certify_path`.
 
     The path's true minimum clearance lies in [lower_bound, min_distance]; when ``ok`` the two
-    are at most the requested ``tol`` apart.
+    are at most the requested ``tol`` apart, unless the check budget ran out first (module
+    docstring: then ``lower_bound`` is a looser proven bound above the margin).
 
     Attributes:
         ok: proven: the exact signed distance stays above the margin on the whole continuous
@@ -285,6 +290,13 @@ def certify_by_bisection(
         if proven.any():
             lower = min(lower, float(np.min(bound[proven])))
         keep = ~(hit | proven | stuck)
+        if n_checks + int(keep.sum()) > max_checks and math.isfinite(tol):
+            # no budget left for tightness: pieces already above the margin are proven with
+            # their (looser) bound, the rest are bisected for the margin alone (tol = inf)
+            loose = keep & (bound > margin)
+            if loose.any():
+                lower = min(lower, float(np.min(bound[loose])))
+            keep, tol = keep & ~loose, math.inf
         if n_checks + int(keep.sum()) > max_checks:
             bad.update(seg[keep].tolist())
             reasons.append(f"the check budget ({max_checks} coal evaluations) ran out")

@@ -3,6 +3,7 @@ certificate is ``ok`` only with an empty reason (planar, 3-D and the cubic-curve
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -82,3 +83,41 @@ def test_curve_budget_is_never_exceeded(splits, max_checks):
     if 2 * splits + 1 > max_checks:
         assert not cert.ok and cert.n_checks == 0
     assert cert.ok == (cert.lower_bound > -math.inf)
+
+
+def test_a_path_proven_at_the_margin_is_not_failed_for_want_of_a_tight_bound():
+    """The UR5e path is proven above 2 cm with 126 checks (tol = inf); with tol = 1e-3 the
+    bisection went on tightening the bound and failed at 1000 ("the check budget ran out"),
+    as the planner's final certificate failed a 40-joint arm's straight line proven free."""
+    path = np.stack([HOME3D, HOME3D + 0.2, HOME3D - 0.1])
+    margin_only = arm3d.certify_path3d(SCENE3D, path, margin=0.02, tol=math.inf)
+    assert margin_only.ok and margin_only.n_checks < 200
+    for max_checks in (200, 1000):
+        cert = arm3d.certify_path3d(SCENE3D, path, 0.02, tol=1e-3, max_checks=max_checks)
+        assert cert.ok and cert.reason == "" and cert.n_checks <= max_checks
+        assert 0.02 < cert.lower_bound <= cert.min_distance
+    tight = arm3d.certify_path3d(SCENE3D, path, 0.02, tol=1e-3, max_checks=20_000)
+    assert tight.ok and tight.min_distance - tight.lower_bound <= 1e-3  # budget enough: tight
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    max_checks=st.integers(1, 1500),
+    tol=st.sampled_from([1e-6, 1e-3, math.inf]),
+    scale=st.floats(0.05, 0.6),
+    seed=st.integers(0, 1000),
+)
+def test_a_certificate_cut_short_by_its_budget_is_still_sound(max_checks, tol, scale, seed):
+    """Whatever the budget: ok only with every sampled configuration's exact distance above
+    the proven lower bound, and that bound above the margin."""
+    from gdnplan.exact import exact_distance
+
+    rng = np.random.default_rng(seed)
+    path = HOME3D + scale * rng.uniform(-1, 1, (3, 6))
+    cert = arm3d.certify_path3d(SCENE3D, path, margin=0.01, tol=tol, max_checks=max_checks)
+    assert_honest(cert, max_checks, 2 * 4 + 1)
+    if cert.ok:
+        s = np.linspace(0, 1, 40)[:, None]
+        dense = np.concatenate([a + s * (b - a) for a, b in itertools.pairwise(path)])
+        sampled = float(np.min(exact_distance(SCENE3D, dense, margin=0.01)))
+        assert 0.01 < cert.lower_bound <= sampled
