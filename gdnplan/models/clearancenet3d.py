@@ -5,6 +5,15 @@ the joint angles and a fixed-size obstacle vector, the pose of every obstacle in
 order — for ``ur5e_boxes`` the centre and full sides (m) of each of the N_BOXES boxes:
 
     d̂(q, O) = scale · MLP([q / π, c_1, s_1, …, c_M, s_M]),    ∂d̂/∂q by autograd.
+
+The sides are the box's extents along the world axes: a box turned by a multiple of 90° gives
+its permuted sides; any other rotation has no input and is refused. The robot is not an input
+at all: the MLP knows only the arm it was trained on (:data:`TRAINED`, the UR5e among the
+random boxes of ``ur5e_boxes``; :func:`gdnplan.train.clearancenet3d.load_arrays`), so
+:meth:`ClearanceNet3DModel.check_scene` refuses another robot (the UR5 has six joints too and
+got the UR5e's distances), another joint count (torch's "mat1 and mat2 shapes cannot be
+multiplied") and obstacles outside that training
+(:func:`gdnplan.models.graphdistnet3d.fit.check_fits3d`).
 """
 
 from __future__ import annotations
@@ -18,6 +27,8 @@ from torch import nn
 from ..arm3d import Scene3D
 from ..errors import InputError
 from ..scene import check_scene
+
+TRAINED = {"robot": "ur5e", "env": "ur5e_boxes"}  # the scenes ClearanceNet-3D is trained on
 
 
 @dataclass(frozen=True)
@@ -57,14 +68,25 @@ def box_vector(centers: np.ndarray, sizes: np.ndarray) -> np.ndarray:
 
 
 def scene_vector(scene: Scene3D, n_boxes: int) -> np.ndarray:
-    """(6 M,) obstacle vector of a scene of exactly ``n_boxes`` axis-aligned boxes."""
+    """(6 M,) obstacle vector of a scene of exactly ``n_boxes`` axis-aligned boxes: centres and
+    extents along the world axes (m); InputError for another count, shape or a rotation that
+    is not a multiple of 90° about the axes."""
     if len(scene.obstacles) != n_boxes or not all(
         hasattr(o.shape, "halfSide") for o in scene.obstacles
     ):
         raise InputError(f"scene: ClearanceNet-3D takes exactly {n_boxes} boxes")
     centers = np.array([o.pose.getTranslation() for o in scene.obstacles])
-    sizes = np.array([2 * np.asarray(o.shape.halfSide) for o in scene.obstacles])
-    return box_vector(centers, sizes)
+    turns = np.abs(np.array([o.pose.getRotation() for o in scene.obstacles]))  # (M, 3, 3)
+    tilted = [
+        i for i, r in enumerate(turns) if not np.allclose(np.sort(r, 1), [0, 0, 1], atol=1e-6)
+    ]
+    if tilted:
+        raise InputError(
+            f"scene.obstacles[{tilted[0]}] ({scene.obstacles[tilted[0]].name!r}): ClearanceNet-3D "
+            "takes axis-aligned boxes (its input has no rotation); use collision='coal'"
+        )
+    sides = np.array([2 * np.asarray(o.shape.halfSide) for o in scene.obstacles])
+    return box_vector(centers, np.einsum("mij,mj->mi", turns, sides))
 
 
 class ClearanceNet3DModel:
@@ -75,9 +97,29 @@ class ClearanceNet3DModel:
     def __init__(self, net: ClearanceNet3D, dtype: torch.dtype = torch.float32):
         self.net = net.to(dtype).eval()
         self.dtype = dtype
+        self._fits: Scene3D | None = None  # the last scene check_scene accepted
+
+    def check_scene(self, scene: Scene3D) -> None:
+        """InputError unless ``scene`` is one the MLP takes (module docstring): a 3-D scene of
+        the trained robot (:data:`TRAINED`) with the net's joint count, and exactly
+        ``n_boxes`` boxes of the training distribution."""
+        check_scene(scene, "3d", "a planar model (ClearanceNet)")
+        if scene is self._fits:
+            return
+        from .graphdistnet3d.fit import check_fits3d
+
+        dof, robot = self.net.config.dof, scene.robot
+        if robot.dof != dof:
+            raise InputError(
+                f"scene.robot: this ClearanceNet-3D takes {dof} joint angles, robot "
+                f"{robot.name!r} has {robot.dof}; use collision='coal'"
+            )
+        check_fits3d(TRAINED, 8, scene)
+        scene_vector(scene, self.net.config.n_boxes)
+        self._fits = scene
 
     def _inputs(self, scene: Scene3D, q) -> tuple[torch.Tensor, torch.Tensor]:
-        check_scene(scene, "3d", "a planar model (ClearanceNet)")
+        self.check_scene(scene)
         q = torch.as_tensor(scene.robot.check_q(q), dtype=self.dtype)
         o = torch.as_tensor(scene_vector(scene, self.net.config.n_boxes), dtype=self.dtype)
         return q, o.expand(len(q), -1)
