@@ -40,6 +40,7 @@ REL_THICKNESS = 1e-4  # hull thickness / diameter floor (coal's hull crashed nea
 MAX_HULL_POINTS = 100_000  # points of one convex hull (mesh vertices)
 CONVEX_TOLERANCE = 1e-6  # a mesh vertex deeper than this · diameter inside its hull: non-convex
 ROTATION_TOLERANCE = 1e-6  # largest |RᵀR − I| entry of a rotation matrix
+ORTHONORMAL_ROUNDING = 4e-15  # |RᵀR − I| of a float64 rotation (an SVD's is ≤ 1.2e-15)
 DEPTH_BLOCK = 4_000_000  # (facet, point) entries per block of the convexity check (32 MB)
 
 log = logging.getLogger("gdnplan.arm3d")
@@ -315,6 +316,8 @@ def as_rotation(rotation, name: str = "rotation") -> np.ndarray:
             f"{name}: not a rotation matrix (|RᵀR − I| = {error:.3g}, det = "
             f"{np.linalg.det(rot):.3g}); give an orthonormal matrix with determinant +1"
         )
+    if error <= ORTHONORMAL_ROUNDING:  # a rotation to rounding: kept, so that a matrix read
+        return rot  # back from a written problem file is the one written, bit for bit
     u, _, vt = np.linalg.svd(rot)  # nearest exact rotation
     return u @ vt
 

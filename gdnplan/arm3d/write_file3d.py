@@ -25,6 +25,10 @@ from .robot3d import Robot3D
 from .scene3d import Obstacle3D, Scene3D
 
 BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+# TOML basic strings hold no control character (U+0000–U+001F, U+007F) but a tab: an obstacle
+# named "a\nb" (a problem file's escape) was written raw and the file could not be read back
+_ESCAPES = {chr(c): f"\\u{c:04X}" for c in [*range(0x20), 0x7F] if c != 0x09}
+_ESCAPES.update({"\\": "\\\\", '"': '\\"'})
 
 
 def shape_table(shape, rotation: np.ndarray, position: np.ndarray, name: str, points=None) -> dict:
@@ -74,7 +78,7 @@ def held_table(robot: Robot3D) -> dict | None:
 def _value(v) -> str:
     """A TOML value: string, boolean, finite number, list or inline table."""
     if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return '"' + "".join(_ESCAPES.get(c, c) for c in v) + '"'
     if isinstance(v, bool | np.bool_):
         return "true" if v else "false"
     if isinstance(v, int | np.integer):
