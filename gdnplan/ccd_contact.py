@@ -27,6 +27,7 @@ still stay apart (d > 0), as in :func:`gdnplan.arm3d.certify_path3d`.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,7 +35,10 @@ from .ccd import MAX_CHECKS, MAX_SPLITS, Certificate, certify_by_bisection
 from .errors import InputError
 from .exact import exact_distance, motion_bound_of, swept_radius_of
 from .limits import check_int, check_number
-from .scene import check_scene
+from .scene import Scene, check_scene
+
+if TYPE_CHECKING:
+    from .arm3d.scene3d import Scene3D
 
 CONTACT_ALLOWANCE = 1e-5  # m: the proven bound on penetration along a path leaving contact
 MAX_ALLOWANCE = 1e-3  # m: a larger "allowance" is a collision, not a contact
@@ -43,7 +47,7 @@ CONTACT_MAX_CHECKS = 20_000  # coal evaluations allowed
 
 
 def certify_from_contact(
-    scene,
+    scene: Scene | Scene3D,
     q_path: np.ndarray,
     allowance: float = CONTACT_ALLOWANCE,
     min_splits: int = CONTACT_SPLITS,

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,7 +45,12 @@ from .ccd import MAX_CHECKS, MAX_SPLITS, MIN_PIECE, proven_distance
 from .errors import InputError
 from .exact import exact_distance, motion_bound_of, swept_radius_of
 from .limits import check_int, check_number
-from .scene import check_scene
+from .scene import Scene, check_scene
+
+if TYPE_CHECKING:
+    from scipy.interpolate import PPoly
+
+    from .arm3d.scene3d import Scene3D
 
 CURVE_SPLITS = 4  # pieces each knot interval starts with
 CURVE_MAX_CHECKS = 200_000  # coal evaluations allowed
@@ -99,8 +105,8 @@ class CurveCertificate:
 
 
 def certify_curve(
-    scene,
-    curve,
+    scene: Scene | Scene3D,
+    curve: PPoly,
     margin: float = 0.0,
     tol: float = 1e-3,
     splits: int = CURVE_SPLITS,
