@@ -260,3 +260,31 @@ def test_gdnplan_plan_certifies_a_problem_file_with_a_scanned_cloud(tmp_path, ca
     assert e.value.code == 0
     result = json.loads(capsys.readouterr().out)
     assert result["success"] and result["min_distance"] > 0.02
+
+
+@settings(max_examples=10, deadline=None)
+@given(
+    edge=st.sampled_from([0.001, 0.002, 0.005]),
+    side=st.floats(0.3, 1.0),
+    seed=st.integers(0, 2**16),
+)
+@example(edge=0.001, side=1.0, seed=0)  # 10⁶ voxels: 0.6 s per distance, plans for hours
+def test_a_cloud_of_too_many_voxels_is_refused_with_a_resolution_that_fits(edge, side, seed):
+    """A distance to an octree costs ~0.5 µs per occupied voxel: a dense scan at a fine
+    resolution made every plan run for hours; it is refused, naming a resolution that the
+    same points pass at."""
+    from gdnplan.arm3d.cloud3d import MAX_VOXELS
+
+    rng = np.random.default_rng(seed)
+    pts = np.column_stack(
+        [rng.uniform(0.5, 0.502, 300_000), rng.uniform(-side, side, (300_000, 2))]
+    )
+    voxels = len(np.unique(np.floor(pts / edge), axis=0))
+    if voxels <= MAX_VOXELS:
+        assert cloud_obstacle(pts, edge).points.shape == pts.shape
+        return
+    with pytest.raises(InputError, match=rf"occupy {voxels} voxels .*resolution = ") as e:
+        cloud_obstacle(pts, edge, name="scan")
+    suggested = float(str(e.value).split("resolution = ")[1].split(" m")[0])
+    assert suggested > edge and len(np.unique(np.floor(pts / suggested), axis=0)) <= MAX_VOXELS
+    cloud_obstacle(pts, suggested)
