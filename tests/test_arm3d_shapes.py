@@ -338,3 +338,12 @@ def test_the_blocked_convexity_check_agrees_with_every_facet_and_vertex(n, depth
         assert is_convex_mesh(points) == (deepest <= tol)
     finally:
         shapes.DEPTH_BLOCK = old_block
+
+
+def test_a_mesh_of_too_many_vertices_names_the_fix():
+    """ "expected (k, 3) points with 4 ≤ k ≤ 100000, got (3000000, 3)" named no fix."""
+    from gdnplan.arm3d.shapes import MAX_HULL_POINTS
+
+    points = _fibonacci_sphere(MAX_HULL_POINTS + 1)
+    with pytest.raises(InputError, match=r"^dense: the mesh has 100001 vertices.*decimate"):
+        mesh_hull(points, "dense")

@@ -201,6 +201,12 @@ def _coal_hull(vertices: np.ndarray) -> coal.ConvexBase:
 
 def mesh_hull(vertices, name: str) -> coal.ConvexBase:
     """The convex hull of a mesh's vertices (k, 3); logs a note when the mesh is not convex."""
+    count = len(vertices) if isinstance(vertices, (np.ndarray, list, tuple)) else 0
+    if count > MAX_HULL_POINTS:  # as_points' "expected (k, 3) points with …" named no fix
+        raise InputError(
+            f"{name}: the mesh has {count} vertices, more than {MAX_HULL_POINTS}; only its "
+            "convex hull is used: simplify (decimate) the mesh or give its hull"
+        )
     pts = as_points(vertices, name)
     hull_pts, hull = hull_vertices(pts, name)
     depth = _deepest_inside(pts, hull, _convex_tolerance(pts))
