@@ -104,3 +104,4 @@ def test_the_fetch_command_loads_storage_weights_and_refuses_others(tmp_path):
     with pytest.raises(InputError) as e:
         learned_fetch_model(None)
     assert str(e.value) == NOT_STORAGE
+    assert "--weights ur5e_storage3d" in NOT_STORAGE  # the shipped weights that fit, named

@@ -27,7 +27,8 @@ def parse_placement(text: str | None):
 NOT_STORAGE = (
     "--collision graphdistnet: the 3-D fetch needs GraphDistNet-3D weights trained on the storage "
     "and the fetch's gripper and held stick (env ur5e_storage; the shipped "
-    "ur5e_boxes3d_preliminary refuse them); give such --weights or use --collision coal"
+    "ur5e_boxes3d_preliminary refuse them); give such --weights (the shipped "
+    "ur5e_storage3d: --weights ur5e_storage3d) or use --collision coal"
 )
 
 
