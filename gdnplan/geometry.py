@@ -141,16 +141,22 @@ def simplify_convex(poly: np.ndarray, max_vertices: int) -> np.ndarray:
     return poly
 
 
+MEET_REACH = 2.0  # hull extents: how far a dropped edge's neighbours may meet
+
+
 def enclosing_convex(points: np.ndarray, max_vertices: int) -> np.ndarray:
     """A CCW convex polygon of at most ``max_vertices`` (≥ 3) vertices containing ``points``.
 
     :func:`simplify_convex` drops hull vertices and so cuts corners off; here edges of the hull
     are dropped instead, least area added first: the two neighbouring edges are extended to
     meet (possible where they converge), so the polygon only grows. Where no edge can go (a
-    rectangle's parallel sides), the simplified hull's edges are pushed out until every point
-    is on their inner side (:func:`_push_out`).
+    rectangle's parallel sides, or neighbours so close to parallel that they would meet more
+    than ``MEET_REACH`` hull extents away: a rectangle tilted by 1e-3 rad made a triangle
+    10⁶ m long), the simplified hull's edges are pushed out until every point is on their
+    inner side (:func:`_push_out`).
     """
     hull = convex_hull(points)
+    reach = MEET_REACH * float(np.ptp(hull, axis=0).max())
     poly = hull
     while len(poly) > max_vertices:
         a, b = poly, np.roll(poly, -1, 0)  # edge i: a[i] → b[i]
@@ -162,6 +168,7 @@ def enclosing_convex(points: np.ndarray, max_vertices: int) -> np.ndarray:
             meet = a + t[:, None] * d1
         added = 0.5 * np.abs((meet - a)[:, 0] * gap[:, 1] - (meet - a)[:, 1] * gap[:, 0])
         ok = (turn > 1e-12 * np.linalg.norm(d1, axis=1) * np.linalg.norm(d2, axis=1)) & (t >= 0)
+        ok &= np.linalg.norm(meet - a, axis=1) <= reach  # NaN (parallel) is not ≤: refused
         if not ok.any():
             return _push_out(hull, simplify_convex(poly, max_vertices))
         i = int(np.argmin(np.where(ok, added, np.inf)))

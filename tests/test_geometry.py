@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import Point, Polygon
 
@@ -135,6 +135,38 @@ def test_convex_decomposition_is_exact_at_the_vertex_limit():
     poly = _star(geo.MAX_VERTICES)  # the old O(n³) merge took 162 s at 400 vertices
     parts = geo.convex_decomposition(poly)
     assert sum(Polygon(p).area for p in parts) == pytest.approx(Polygon(poly).area, rel=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    tilt=st.floats(-0.05, 0.05),
+    size=st.tuples(st.floats(0.05, 2.0), st.floats(0.05, 2.0)),
+    arcs=st.integers(3, 20),
+    bulge=st.floats(0.0, 0.1),
+    most=st.integers(3, 6),
+)
+@example(tilt=0.001, size=(0.5, 0.5), arcs=17, bulge=0.02, most=3)  # was a 57 m triangle
+def test_an_enclosing_polygon_of_a_near_rectangle_stays_near_it(tilt, size, arcs, bulge, most):
+    """A slightly tilted rectangle with elliptic ends (a cylinder seen from its side) has
+    neighbouring hull edges that are nearly parallel: their meeting point lies far away, and
+    the enclosing polygon must not go there (a link of a user's URDF failed its thickness
+    check as "flat": a 1 m link got a triangle 2.6e6 m long)."""
+    w, h = size
+    a = np.linspace(-np.pi / 2, np.pi / 2, arcs)
+    end = np.c_[w / 2 + bulge * w * np.cos(a), h / 2 * np.sin(a)]
+    side = np.linspace(-w / 2, w / 2, arcs)
+    pts = np.vstack(
+        [end, end * [-1, 1], np.c_[side, side * 0 + h / 2], np.c_[side, side * 0 - h / 2]]
+    )
+    c, s = np.cos(tilt), np.sin(tilt)
+    pts = (pts + np.array([0.5, 0.0])) @ np.array([[c, s], [-s, c]])
+    poly = geo.enclosing_convex(pts, most)
+    assert 3 <= len(poly) <= most and geo.is_convex(poly)
+    assert np.ptp(poly, axis=0).max() <= 6 * np.ptp(pts, axis=0).max()  # near the points
+    geo.check_part(poly, "near rectangle")  # thick: not the far-away sliver
+    shape = Polygon(poly)
+    outside = [shape.exterior.distance(Point(p)) for p in pts if not shape.contains(Point(p))]
+    assert max(outside, default=0.0) <= 1e-9 * (1 + np.abs(pts).max())
 
 
 @settings(max_examples=60, deadline=None)
