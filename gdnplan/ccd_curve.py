@@ -30,7 +30,10 @@ scene's swept radius :func:`gdnplan.exact.swept_radius_of`) and δ from T,
 and :func:`certify_curve` bisects pieces in s (never across a knot, where the cubic changes)
 until every bound is above the margin and within ``tol`` of the smallest checked distance; a
 configuration within the margin, a piece too small to bisect or the check budget running out
-is a failure, never an acceptance.
+is a failure, never an acceptance. Tightness yields first: when a piece cannot be bisected or
+the budget would run out, pieces already above the margin are proven with their looser bound
+and the rest are bisected for the margin alone (as :func:`gdnplan.ccd.certify_path`: a curve
+proven above the margin was refused, and timed ``stop``, for want of a tight bound).
 """
 
 from __future__ import annotations
@@ -156,10 +159,13 @@ def certify_curve(
         delta = motion_bound_of(robot, zero[None], _travel(curve, sa, sb))
         bound = (da + db - delta) / 2
         proven = (bound > margin) & (bound >= best - tol)
+        keep = ~proven
+        if math.isfinite(tol) and _cut_short(keep, delta, n_checks, max_checks):
+            proven |= keep & (bound > margin)  # above the margin: proven, with a looser bound
+            keep, tol = ~proven, math.inf  # the rest: the margin alone
         if proven.any():
             lower = min(lower, float(np.min(bound[proven])))
-        keep = ~proven
-        if np.any(keep & (delta < MIN_PIECE)) or n_checks + int(keep.sum()) > max_checks:
+        if _cut_short(keep, delta, n_checks, max_checks):
             return CurveCertificate(False, -math.inf, n_checks)
         sa, sb, da, db = sa[keep], sb[keep], da[keep], db[keep]
         mid = (sa + sb) / 2
@@ -170,6 +176,12 @@ def certify_curve(
         sa, sb = np.concatenate([sa, mid]), np.concatenate([mid, sb])
         da, db = np.concatenate([da, dm]), np.concatenate([dm, db])
     return CurveCertificate(True, lower, n_checks)
+
+
+def _cut_short(keep: np.ndarray, delta: np.ndarray, n_checks: int, max_checks: int) -> bool:
+    """Whether the pieces ``keep`` cannot all be bisected: one is below MIN_PIECE, or their
+    midpoints would exceed the check budget."""
+    return bool(np.any(keep & (delta < MIN_PIECE))) or n_checks + int(keep.sum()) > max_checks
 
 
 __all__ = ["CurveCertificate", "certify_curve"]

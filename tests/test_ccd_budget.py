@@ -121,3 +121,18 @@ def test_a_certificate_cut_short_by_its_budget_is_still_sound(max_checks, tol, s
         dense = np.concatenate([a + s * (b - a) for a, b in itertools.pairwise(path)])
         sampled = float(np.min(exact_distance(SCENE3D, dense, margin=0.01)))
         assert 0.01 < cert.lower_bound <= sampled
+
+
+def test_a_curve_proven_at_the_margin_is_not_refused_for_want_of_a_tight_bound():
+    """The cubic through the same waypoints is proven above 2 cm with 119 checks (tol huge);
+    with tol = 1e-3 it was refused at 200, 400 and 1000 checks, so time_path fell back to
+    'stop' for a curve that is certified."""
+    from gdnplan.exact import exact_distance
+
+    curve = PchipInterpolator([0.0, 1.0, 2.0], np.stack([HOME3D, HOME3D + 0.2, HOME3D - 0.1]))
+    dense = curve(np.linspace(0.0, 2.0, 400))
+    sampled = float(np.min(exact_distance(SCENE3D, dense, margin=0.02)))
+    for max_checks in (200, 400, 1000):
+        cert = certify_curve(SCENE3D, curve, 0.02, tol=1e-3, max_checks=max_checks)
+        assert cert.ok and cert.n_checks <= max_checks
+        assert 0.02 < cert.lower_bound <= sampled
