@@ -28,7 +28,7 @@ from .ccd import Certificate, proven_distance
 from .errors import InputError
 from .exact import certify, exact_distance, swept_radius_of
 from .flags import check_flag
-from .limits import check_number
+from .limits import check_int, check_number
 from .robot import as_batch, first_outside
 from .rrt import edge_free
 from .scene import Scene
@@ -40,6 +40,7 @@ PLANNERS = {  # name -> OMPL geometric planner class
     "rrtstar": "RRTstar",
 }
 MAX_TIME = 600.0  # s, one planning call
+MAX_OMPL_SEED = 2**32 - 1  # OMPL seeds its generators with an unsigned 32-bit integer
 SIMPLIFY_SHARE = 0.2  # share of the time limit kept for path simplification
 _SEEDED: list[int] = []  # OMPL's global seed can be set once per process, before any planner
 
@@ -219,13 +220,14 @@ def plan_ompl(
     ``lower``/``upper`` (dof,) rad: the joint box, finite, within the robot's joint limits
     (1e-9 rad of slack), lower < upper on every joint, start and goal inside it (the robot's
     limits when None; InputError naming ``lower``, ``upper``, ``start`` or ``goal`` otherwise,
-    before OMPL is imported). ``seed`` seeds
+    before OMPL is imported). ``seed`` (an integer in [0, 2³² − 1]) seeds
     OMPL's generators the first time any planner runs in this process (OMPL allows one global
     seed); a run is reproducible for the same seed and sequence of calls up to time limits (an
     anytime planner's result depends on how far it got in its time). Raises InputError on bad
     input or without OMPL.
     """
     simplify = check_flag(simplify, "simplify")
+    check_int(seed, "seed", 0, MAX_OMPL_SEED)  # OMPL's binding raised TypeError for −1
     start, goal, lower, upper = _check(
         scene, start, goal, lower, upper, clearance, time_limit, planner
     )

@@ -74,3 +74,13 @@ def test_ompl_honours_its_time_limit_in_3d(monkeypatch):
         return
     assert called[0] - t0 < 0.5 + 0.5  # one motion check under way at most
     assert not result.success or certify_path3d(scene, result.path, 0.02).ok
+
+
+@pytest.mark.parametrize("seed", [-1, 2**32, 1.5, "a", True, None])
+def test_a_seed_that_is_no_ompl_seed_is_refused(seed):
+    """OMPL's binding raised TypeError for −1, int() a ValueError for "a", and 1.5 became 1."""
+    from gdnplan.errors import InputError
+
+    scene = Scene3D(load_robot3d("ur5e"), [box_obstacle((0.1, 0.1, 0.6), (0.45, 0.0, 0.3))])
+    with pytest.raises(InputError, match=r"^seed: expected an integer in \[0, 4294967295\]"):
+        plan_ompl(scene, START, GOAL, 0.02, time_limit=0.1, seed=seed)

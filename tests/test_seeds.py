@@ -264,6 +264,17 @@ def test_an_aorrtc_seed_is_refined_and_certified():
     assert_certified(problem, result)
 
 
+def test_an_aorrtc_seed_of_a_large_plan_seed_runs():
+    """plan(seed=…) takes up to 2⁶²; OMPL's seed is 32-bit (plan_ompl refuses more)."""
+    pytest.importorskip("ompl")
+    from gdnplan.limits import MAX_SEED
+
+    problem = Problem.from_toml("planar2_square")
+    cfg = PlanConfig(seed=SeedConfig(kinds=("aorrtc",), count=1))
+    result = plan(problem, collision="coal", solver=cfg, seed=MAX_SEED)
+    assert result.success, result.reason
+
+
 def test_a_seed_kind_whose_dependency_is_missing_says_how_to_install_it(monkeypatch):
     from gdnplan.trajopt.config import MISSING_SEED_KINDS
 

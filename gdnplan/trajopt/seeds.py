@@ -177,14 +177,14 @@ def aorrtc_seed(request: SeedRequest) -> np.ndarray | None:
     least Σ‖Δq‖²). OMPL seeds its generator once per process, so ``request.stream`` does not
     pick its run (not reproducible). Needs OMPL (``pip install 'gdnplan[bench]'``)."""
 
-    from ..ompl_planner import plan_ompl
+    from ..ompl_planner import MAX_OMPL_SEED, plan_ompl
 
     p = request.problem
     budget = min(request.time_limit, OMPL_TIME)
     clearance = min(request.clearance, p.margin)  # not more: the short way may be narrow
     r = plan_ompl(
         p.scene, p.start, request.goal, clearance, "aorrtc", budget,
-        seed=request.stream, lower=p.lower, upper=p.upper,
+        seed=request.stream % (MAX_OMPL_SEED + 1), lower=p.lower, upper=p.upper,
     )  # fmt: skip
     if not r.success:
         return None
