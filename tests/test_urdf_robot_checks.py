@@ -182,6 +182,9 @@ def mesh_case(folder: Path, case: str) -> tuple[str, str]:
         return cube_obj(folder / "nan.obj", "1 1 nan").name, "NaN or infinite"
     if case == "far":
         return cube_obj(folder / "far.obj", "1 1 5000").name, "beyond 1000 m"
+    if case == "empty_stl":  # a valid header, no facet: assimp's reason is passed on
+        (folder / "empty.stl").write_bytes(bytes(80) + (0).to_bytes(4, "little"))
+        return "empty.stl", "(assimp: STL: file is empty"
     assert case == "empty"
     (folder / "empty.obj").write_text("# nothing\n")
     return "empty.obj", "mesh"
@@ -189,7 +192,19 @@ def mesh_case(folder: Path, case: str) -> tuple[str, str]:
 
 @KINDS
 @pytest.mark.parametrize(
-    "case", ["text", "directory", "device", "missing", "outside", "scheme", "nan", "far", "empty"]
+    "case",
+    [
+        "text",
+        "directory",
+        "device",
+        "missing",
+        "outside",
+        "scheme",
+        "nan",
+        "far",
+        "empty",
+        "empty_stl",
+    ],
 )
 def test_a_bad_mesh_file_is_named_with_its_link_and_path(tmp_path, capfd, kind, case):
     filename, what = mesh_case(tmp_path, case)

@@ -108,7 +108,18 @@ def _read_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarra
         except (ValueError, RuntimeError) as e:
             raise InputError(
                 f"{where}: {found} is not a mesh file assimp can read (STL, OBJ, DAE, ...)"
+                f"{_assimp_reason(e)}"
             ) from e
     if bvh.num_vertices == 0:
         return np.zeros((0, 3))
     return np.asarray(bvh.vertices(), float).reshape(-1, 3)
+
+
+def _assimp_reason(error: Exception) -> str:
+    """ " (assimp: <its reason>)" from coal's loader error, the line after "Could not load
+    resource …" (e.g. "STL: file is empty. There are no facets defined"); "" without one."""
+    lines = [line.strip() for line in str(error).splitlines()]
+    for k, line in enumerate(lines[:-1]):
+        if "Could not load resource" in line and not lines[k + 1].startswith("Hint:"):
+            return f" (assimp: {lines[k + 1][:200]})" if lines[k + 1] else ""
+    return ""
