@@ -187,3 +187,33 @@ def test_random_boxes_check_robot_and_size(robot, size, message):
     robot = load_robot3d(robot) if robot == "ur5e" else gp.load_robot(robot)
     with pytest.raises(InputError, match=message):
         random_boxes(robot, 3, size=size)
+
+
+@settings(max_examples=25, deadline=None)
+@given(share=st.floats(0.0, 1.0, exclude_max=True), n=st.integers(1, 50))
+@example(share=1.0 - 1e-6, n=20)  # a clearance just below the reach drew boxes for ever
+@example(share=0.95, n=50)
+def test_random_boxes_never_loop_for_ever_near_the_reach(share, n):
+    """Box centres are drawn in the half ball of the reach and kept beyond base_clearance
+    from the base axis: a clearance that leaves too small a share of the draws (MIN_ROOM) is
+    refused, naming the largest one accepted; any other draws its boxes quickly."""
+    import math
+    import time
+
+    from gdnplan.arm3d.scene3d import MIN_ROOM, workspace_radius
+
+    robot = load_robot3d("ur5e")
+    reach = workspace_radius(robot)
+    clearance = share * reach
+    room = math.pi / 6 * (1 - share**2) ** 1.5
+    if room < MIN_ROOM:
+        with pytest.raises(InputError, match=r"^base_clearance: .* give at most") as e:
+            random_boxes(robot, n, base_clearance=clearance)
+        most = float(str(e.value).rsplit("at most ", 1)[1].split(" m")[0])
+        random_boxes(robot, 1, base_clearance=most * (1 - 1e-3))  # the one named is accepted
+        return
+    t0 = time.perf_counter()
+    scene = random_boxes(robot, n, base_clearance=clearance)
+    centres = np.array([o.pose.getTranslation() for o in scene.obstacles])
+    assert len(centres) == n and np.all(np.hypot(centres[:, 0], centres[:, 1]) >= clearance)
+    assert time.perf_counter() - t0 < 30.0

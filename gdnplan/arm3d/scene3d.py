@@ -13,6 +13,7 @@ Every number is validated before coal sees it. A TOML schema comes later; the Py
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -39,6 +40,7 @@ from .shapes import (
 MAX_OBSTACLES = 10_000
 BOX_SIZE = (0.05, 0.2)  # m: random_boxes' default (smallest, largest) side
 BASE_CLEARANCE = 0.25  # m: random_boxes' default distance of box centres from the base axis
+MIN_ROOM = 1e-2  # random_boxes: least share of its draws that may land in the allowed region
 
 
 @dataclass(frozen=True)
@@ -199,6 +201,16 @@ def random_boxes(
     reach = workspace_radius(robot)
     if clearance >= reach:
         raise InputError(f"base_clearance: {clearance} m leaves no room in reach {reach:.3g} m")
+    # draws land in the region with probability p = (π/6)(h/reach)³, h = √(reach² − clearance²)
+    # (its volume (2π/3)h³ over the drawn box's 4 reach³): a clearance just below the reach
+    # looped (almost) forever
+    room = math.pi / 6 * (1.0 - (clearance / reach) ** 2) ** 1.5
+    if room < MIN_ROOM:
+        most = reach * math.sqrt(1.0 - (6.0 * MIN_ROOM / math.pi) ** (2.0 / 3.0))
+        raise InputError(
+            f"base_clearance: {clearance} m leaves box centres a sliver of reach "
+            f"{reach:.4g} m ({room:.2g} of the draws); give at most {most:.4g} m"
+        )
     rng = np.random.default_rng(seed)
     boxes: list[Obstacle3D] = []
     while len(boxes) < n:
