@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from gdnplan.arm3d import Scene3D, load_robot3d, signed_distance3d
 from gdnplan.arm3d.scene_file3d import rpy_matrix, scene3d_from_config
-from gdnplan.errors import GdnplanError, InfeasibleProblemError, ProblemFileError
+from gdnplan.errors import GdnplanError, InfeasibleProblemError, InputError, ProblemFileError
 from gdnplan.trajopt import Problem, read_problem_file
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -64,6 +64,25 @@ def test_rpy_is_urdfs_convention():
     rng = np.random.default_rng(0)
     for rpy in rng.uniform(-3, 3, (20, 3)):
         np.testing.assert_allclose(rpy_matrix(rpy), pin.rpy.rpyToMatrix(*rpy), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("rpy", "message"),
+    [
+        ([1e6, 0.0, 0.0], r"within ±1000 rad"),  # was "values beyond 1000 m; use metres"
+        ([math.inf, 0.0, 0.0], r"within ±1000 rad"),
+        ([math.nan, 0.0, 0.0], r"within ±1000 rad"),
+        ([True, 0.0, 0.0], r"expected 3 numbers \(rad\)"),
+        ([0.0, 0.0], r"expected 3 numbers \(rad\)"),
+        ("0 0 0", r"expected 3 numbers \(rad\)"),
+    ],
+)
+def test_a_bad_rpy_is_named_in_radians(rpy, message):
+    with pytest.raises(InputError, match=rf"^rpy: .*{message}") as e:
+        rpy_matrix(rpy)
+    assert " m;" not in str(e.value)
+    with pytest.raises(ProblemFileError, match=message):
+        scene3d_from_config(small(**BOX, rpy=rpy))
 
 
 def test_the_three_rotation_forms_agree():

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import GdnplanError, ProblemFileError
+from ..errors import GdnplanError, InputError, ProblemFileError
 from ..limits import is_number
 from ..scene import no_unknown_keys
 from .cloud3d import DEFAULT_RESOLUTION, cloud_obstacle, read_cloud
@@ -27,9 +27,9 @@ from .scene3d import (
     mesh_obstacle,
     sphere_obstacle,
 )
-from .shapes import as_vector
 
 ROTATION_KEYS = ("quaternion", "rpy", "matrix")
+MAX_RPY = 1e3  # rad: largest |angle| of an rpy (as a URDF origin's, xml_checks.MAX_ANGLE)
 POSE_KEYS = frozenset({"type", "name", "position", *ROTATION_KEYS})
 OBSTACLE3D_KEYS = {  # type -> its own keys besides POSE_KEYS
     "box": frozenset({"size"}),
@@ -44,8 +44,16 @@ OPTIONAL3D_KEYS = {"mesh": frozenset({"scale"}), "cloud": OBSTACLE3D_KEYS["cloud
 
 
 def rpy_matrix(rpy) -> np.ndarray:
-    """R = R_z(yaw) R_y(pitch) R_x(roll) (URDF's fixed-axis roll-pitch-yaw), rpy in rad."""
-    r, p, y = as_vector(rpy, 3, "rpy")
+    """R = R_z(yaw) R_y(pitch) R_x(roll) (URDF's fixed-axis roll-pitch-yaw), rpy in rad:
+    three finite numbers within ±MAX_RPY rad, else InputError."""
+    items = np.asarray(rpy, dtype=object)
+    if items.shape != (3,) or not all(is_number(x) for x in items):
+        raise InputError(f"rpy: expected 3 numbers (rad), got {rpy!r}")
+    r, p, y = items.astype(float)
+    if not all(math.isfinite(a) and abs(a) <= MAX_RPY for a in (r, p, y)):
+        raise InputError(  # as_vector's "values beyond 1000 m; use metres" named no angle
+            f"rpy: expected finite angles within ±{MAX_RPY:g} rad, got {rpy!r}"
+        )
     cr, sr, cp, sp, cy, sy = (f(a) for a in (r, p, y) for f in (math.cos, math.sin))
     return np.array(
         [
