@@ -166,6 +166,15 @@ def check_certify_args(
     check_flag(stop_early, "stop_early")
 
 
+def check_path(robot, q_path: np.ndarray) -> np.ndarray:
+    """The waypoints q_path (K, dof) (rad) of a path to certify, K ≥ 1, checked by ``robot``
+    (planar or 3-D: its ``check_q``), else InputError naming ``q_path``."""
+    q_path = robot.check_q(q_path, "q_path")
+    if not len(q_path):
+        raise InputError("q_path: expected at least one waypoint, got none")
+    return q_path
+
+
 def check_robot(robot: object) -> Robot:
     """``robot`` when it is a planar :class:`~gdnplan.robot.Robot`, else InputError naming it."""
     if not isinstance(robot, Robot):
@@ -226,9 +235,7 @@ def certify_path(
     check_scene(scene, use="gdnplan.arm3d.certify_path3d")
     check_certify_args(margin, tol, min_splits, max_checks, stop_early)
     robot = scene.robot
-    q_path = robot.check_q(q_path, "q_path")
-    if not len(q_path):
-        raise InputError("q_path: expected at least one waypoint, got none")
+    q_path = check_path(robot, q_path)
     return certify_by_bisection(
         q_path,
         lambda q: signed_distance(scene, q),

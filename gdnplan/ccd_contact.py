@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .ccd import MAX_CHECKS, MAX_SPLITS, Certificate, certify_by_bisection
+from .ccd import MAX_CHECKS, MAX_SPLITS, Certificate, certify_by_bisection, check_path
 from .errors import InputError
 from .exact import exact_distance, motion_bound_of, swept_radius_of
 from .limits import check_int, check_number
@@ -77,9 +77,7 @@ def certify_from_contact(
     check_int(min_splits, "min_splits", 1, MAX_SPLITS)
     check_int(max_checks, "max_checks", 1, MAX_CHECKS)
     robot = scene.robot
-    q_path = robot.check_q(q_path, "q_path")
-    if not len(q_path):
-        raise InputError("q_path: expected at least one waypoint, got none")
+    q_path = check_path(robot, q_path)
     return certify_by_bisection(
         q_path,
         lambda q: exact_distance(scene, q, margin=-allowance),
