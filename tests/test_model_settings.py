@@ -52,3 +52,50 @@ def test_a_model_in_another_dtype_leaves_the_callers_network_as_it_was():
     np.testing.assert_allclose(first.distance(scene, q), twin.distance(scene, q), atol=1e-4)
     same = GraphDistNetModel(first.net, first.card)
     assert same.net is first.net  # nothing to change: no copy
+
+
+SET_LATER = [
+    ("threads", 0, "threads: expected an integer"),
+    ("threads", -1, "threads: expected an integer"),
+    ("threads", 2.5, "threads: expected an integer"),
+    ("threads", "2", "threads: expected an integer"),
+    ("threads", True, "threads: expected an integer"),
+    ("chunk", 0, "chunk: expected an integer"),
+    ("chunk", "8", "chunk: expected an integer"),
+    ("fused", "yes", "fused: expected True, False or None"),
+    ("dtype", torch.float64, "dtype: fixed when the model is made"),
+]
+
+
+def _models():
+    """One model of each learned kind (planar GraphDistNet, ClearanceNet, GraphDistNet-3D)."""
+    return [gp.load_model(name) for name in ("d", "clearancenet_b", "ur5e_boxes3d_preliminary")]
+
+
+@pytest.mark.parametrize(("attr", "bad", "match"), SET_LATER, ids=repr)
+def test_a_setting_changed_after_construction_is_checked_as_at_construction(attr, bad, match):
+    for model in _models():
+        if not hasattr(model, attr):
+            continue  # ClearanceNet has no fused pass
+        before = getattr(model, attr)
+        with pytest.raises(gp.InputError, match=match):
+            setattr(model, attr, bad)
+        assert getattr(model, attr) == before
+
+
+def test_3d_settings_changed_later_are_checked_and_take_effect():
+    model = gp.load_model("ur5e_boxes3d_preliminary")
+    for attr, bad in (("self_collision", "no"), ("contact_offset", float("nan"))):
+        with pytest.raises(gp.InputError, match=attr):
+            setattr(model, attr, bad)
+
+
+def test_fused_changed_after_a_call_changes_the_pass():
+    model = gp.load_model("d")
+    scene = gp.make_scene("d", seed=0)
+    q = scene.robot.sample(4, seed=0)
+    model.fused = True
+    fast = model.distance(scene, q)
+    model.fused = False  # the scene's cached compiled pass is dropped, not kept
+    assert model._graphs(scene).whole is None
+    np.testing.assert_allclose(model.distance(scene, q), fast, atol=1e-5)

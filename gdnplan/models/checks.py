@@ -36,9 +36,9 @@ from ..arm3d.scene3d import Scene3D
 from ..errors import InputError
 from ..files import read_input
 from ..scene import ENV_ROBOT, Scene
+from .outputs import RETRAIN, check_magnitudes
 
 FIXED_LAYOUT_ENVS = ("a", "c")  # environments whose obstacles never change (scene.py)
-RETRAIN = "re-download the shipped weights or train them again (gdnplan train)"
 
 
 def parse_card(card: Path, what: str = "weights") -> dict:
@@ -99,7 +99,8 @@ def build_net(
     path: Path, kind: str, make: Callable[[], torch.nn.Module], tensors: dict[str, torch.Tensor]
 ) -> torch.nn.Module:
     """The network ``make()`` holding ``tensors``; InputError when they do not fit it (a
-    missing or unexpected name, another shape, an int, bool or complex tensor).
+    missing or unexpected name, another shape, an int, bool or complex tensor, a value beyond
+    :data:`.outputs.MAX_WEIGHT`).
 
     The network is first built on the meta device (no memory), so a card asking for a huge
     network costs nothing before its shapes are compared with the file's tensors.
@@ -135,6 +136,7 @@ def build_net(
             "another model: keep each .safetensors with its own .json"
         )
     _check_dtypes(path, {k: v.dtype for k, v in meta.items()}, tensors)
+    check_magnitudes(path, tensors)
     net = make()
     net.load_state_dict(tensors)
     return net

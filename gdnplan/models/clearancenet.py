@@ -42,6 +42,8 @@ from .fields import (
     check_widths,
     shown,
 )
+from .outputs import finite
+from .settings import MAX_CHUNK, Checked, Fixed
 from .threads import check_threads, torch_threads
 from .weights import card_path, read_weights, write_weights
 
@@ -186,6 +188,9 @@ class ClearanceNetModel:
     :mod:`gdnplan.models.threads`)."""
 
     is_distance = True
+    threads = Checked(check_threads)  # settable later, checked as here (models/settings.py)
+    chunk = Checked(lambda chunk: check_int(chunk, "chunk", 1, MAX_CHUNK))
+    dtype = Fixed()  # the network's
 
     def __init__(
         self,
@@ -195,15 +200,19 @@ class ClearanceNetModel:
         threads: int | None = None,
     ):
         self.net = net.eval()
-        self.threads = check_threads(threads)
+        self.threads = threads
         self.card = card or {}
         self.chunk = chunk
         self.name = "ClearanceNet"
+        self.source: str | None = None  # the weights file it was loaded from (messages)
         self.dtype = next(net.parameters()).dtype  # float32 normally; float64 for checks
 
     def _run(self, q: np.ndarray, obst: np.ndarray, grad: bool):
+        """(d̂ (B,), ∂d̂/∂q (B, dof) or None), all finite (else InputError)."""
         with torch_threads(self.threads):
-            return self._run_chunks(q, obst, grad)
+            d, g = self._run_chunks(q, obst, grad)
+        finite(self, d, g)
+        return d, g
 
     def _run_chunks(self, q: np.ndarray, obst: np.ndarray, grad: bool):
         if len(q) == 0:  # an empty batch: empty (0,) and (0, dof) arrays, as coal gives
@@ -272,4 +281,6 @@ def load(path: Path | str, threads: int | None = None) -> ClearanceNetModel:
     config = card_config(path, card, "ClearanceNet", ClearanceNetConfig.from_dict)
     check_count(len(config.hidden) or 1, len(tensors), "hidden", path)
     net = build_net(path, "ClearanceNet", lambda: ClearanceNet(config), tensors)
-    return ClearanceNetModel(net, card, threads=threads)
+    model = ClearanceNetModel(net, card, threads=threads)
+    model.source = str(path)
+    return model

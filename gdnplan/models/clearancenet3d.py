@@ -27,6 +27,8 @@ from torch import nn
 from ..arm3d import Scene3D
 from ..errors import InputError
 from ..scene import check_scene
+from .outputs import finite
+from .settings import Fixed, check_dtype
 
 TRAINED = {"robot": "ur5e", "env": "ur5e_boxes"}  # the scenes ClearanceNet-3D is trained on
 
@@ -93,10 +95,11 @@ class ClearanceNet3DModel:
     """The MLP as a DistanceModel of box scenes (robot–obstacle distance, m; ∂d̂/∂q m/rad)."""
 
     name = "clearancenet3d"
+    dtype = Fixed()  # the network is placed in it (models/settings.py)
 
     def __init__(self, net: ClearanceNet3D, dtype: torch.dtype = torch.float32):
+        self.dtype = check_dtype(dtype)
         self.net = net.to(dtype).eval()
-        self.dtype = dtype
         self._fits: Scene3D | None = None  # the last scene check_scene accepted
 
     def check_scene(self, scene: Scene3D) -> None:
@@ -127,7 +130,9 @@ class ClearanceNet3DModel:
     def distance(self, scene: Scene3D, q) -> np.ndarray:
         q, o = self._inputs(scene, q)
         with torch.no_grad():
-            return self.net(q, o).double().numpy()
+            d = self.net(q, o).double().numpy()
+        finite(self, d)
+        return d
 
     def distance_and_grad(self, scene: Scene3D, q) -> tuple[np.ndarray, np.ndarray]:
         q, o = self._inputs(scene, q)
@@ -135,4 +140,6 @@ class ClearanceNet3DModel:
         with torch.enable_grad():
             d = self.net(q, o)
             (g,) = torch.autograd.grad(d.sum(), q)
-        return d.detach().double().numpy(), g.double().numpy()
+        out = d.detach().double().numpy(), g.double().numpy()
+        finite(self, *out)
+        return out

@@ -1,10 +1,17 @@
 """Checks of a learned model's run settings (dtype, device, chunk, on/off flags), each an
 :class:`~gdnplan.errors.InputError` naming the setting, and :func:`placed`: the network on the
-requested device and dtype without changing the one the caller passed."""
+requested device and dtype without changing the one the caller passed.
+
+A model's settings are checked whenever they are set, not only by its constructor:
+:class:`Checked` attributes (``threads``, ``chunk``, ``contact_offset``) pass the
+constructor's check on every assignment, with its message; :class:`Fixed` ones (``dtype``,
+``device``: the network was placed in them) refuse a new value, naming the fix.
+"""
 
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 
 import torch
 
@@ -47,6 +54,43 @@ def check_flag(value, name: str, optional: bool = False) -> bool | None:
     return flags.check_flag(value, name, optional)
 
 
+class Checked:
+    """A model attribute stored as ``check(value)`` on every assignment (the constructor's
+    check: a bad value is an InputError when set, not a failure later, deep in a call)."""
+
+    def __init__(self, check: Callable[[object], object]):
+        self.check = check
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.slot = f"_{name}"
+
+    def __get__(self, obj: object, owner: type | None = None):
+        return self if obj is None else getattr(obj, self.slot)
+
+    def __set__(self, obj: object, value: object) -> None:
+        setattr(obj, self.slot, self.check(value))
+
+
+class Fixed:
+    """A model attribute set once, by its constructor (after its check); any later assignment
+    is an InputError: the network and its caches were built for the first value."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name, self.slot, self.owner = name, f"_{name}", owner.__name__
+
+    def __get__(self, obj: object, owner: type | None = None):
+        return self if obj is None else getattr(obj, self.slot)
+
+    def __set__(self, obj: object, value: object) -> None:
+        if hasattr(obj, self.slot):
+            raise InputError(
+                f"{self.name}: fixed when the model is made (its network was placed in "
+                f"{getattr(obj, self.slot)}); make another: {self.owner}(model.net, "
+                f"{self.name}={value!r}, …)"
+            )
+        setattr(obj, self.slot, value)
+
+
 def placed(net: torch.nn.Module, device: torch.device, dtype: torch.dtype) -> torch.nn.Module:
     """``net`` in eval mode on ``device`` and ``dtype``: itself when it is there already, else
     a copy (``Module.to`` works in place: the caller's network, used elsewhere, would change)."""
@@ -58,6 +102,8 @@ def placed(net: torch.nn.Module, device: torch.device, dtype: torch.dtype) -> to
 __all__ = [
     "DTYPES",
     "MAX_CHUNK",
+    "Checked",
+    "Fixed",
     "check_chunk",
     "check_device",
     "check_dtype",

@@ -28,7 +28,9 @@ def load_graphdistnet_weights(
         check_count(value, len(tensors), name, path)  # else a huge network before the check
     check_count(len(config.readout) or 1, len(tensors), "readout", path)
     net = build_net(path, "GraphDistNet", lambda: GraphDistNet(config), tensors)
-    return GraphDistNetModel(net, card, threads=threads, fused=fused)
+    model = GraphDistNetModel(net, card, threads=threads, fused=fused)
+    model.source = str(path)
+    return model
 
 
 def load_graphdistnet(path: Path | str, threads: int | None = None) -> GraphDistNetModel:

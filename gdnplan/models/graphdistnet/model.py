@@ -16,7 +16,8 @@ from ...errors import InputError
 from ...graph import GraphBatch, RobotGraph, obstacle_graph, robot_graph, scene_obstacles
 from ...scene import Scene, check_scene
 from ..checks import check_fits
-from ..settings import check_chunk, check_device, check_dtype, check_flag, placed
+from ..outputs import finite, overflow_guard
+from ..settings import Checked, Fixed, check_chunk, check_device, check_dtype, check_flag, placed
 from ..threads import check_threads, torch_threads
 from . import fused as fused_kernel
 from . import fused_net
@@ -54,6 +55,9 @@ class GraphDistNetModel:
     """
 
     name = "graphdistnet"
+    threads = Checked(check_threads)  # settable later, checked as here (models/settings.py)
+    chunk = Checked(check_chunk)
+    dtype, device = Fixed(), Fixed()
 
     def __init__(
         self,
@@ -67,12 +71,22 @@ class GraphDistNetModel:
     ):
         self.dtype = check_dtype(dtype)
         self.device = check_device(device)
-        self.chunk = check_chunk(chunk)
+        self.chunk = chunk
         self.net = placed(net, self.device, self.dtype)
-        self.threads = check_threads(threads)
+        self.threads = threads
         self.config = net.config
         self.card = card or {}
-        self.fused = self._check_fused(check_flag(fused, "fused", optional=True))
+        self.source: str | None = None  # the weights file it was loaded from (messages)
+        self.fused = fused
+
+    @property
+    def fused(self) -> bool:
+        """Whether the fused kernels run (class docstring); set it to True, False or None."""
+        return self._fused
+
+    @fused.setter
+    def fused(self, fused: bool | None) -> None:
+        self._fused = self._check_fused(check_flag(fused, "fused", optional=True))
         self._scenes: weakref.WeakKeyDictionary[Scene, _SceneCache] = weakref.WeakKeyDictionary()
 
     def _check_fused(self, fused: bool | None) -> bool:
@@ -141,7 +155,14 @@ class GraphDistNetModel:
         return torch.as_tensor(nodes, dtype=self.dtype, device=self.device)
 
     def distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
-        """(B,) estimated signed distances (m) of q (B, dof) or (dof,)."""
+        """(B,) estimated signed distances (m) of q (B, dof) or (dof,); InputError when the
+        network gives a NaN or infinite one (:mod:`gdnplan.models.outputs`)."""
+        with overflow_guard(self):
+            d = self._distance(scene, q)
+        finite(self, d)
+        return d
+
+    def _distance(self, scene: Scene, q: np.ndarray) -> np.ndarray:
         check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
         if len(q) == 0:  # an empty batch (the network has no empty pass): (0,)
@@ -162,7 +183,13 @@ class GraphDistNetModel:
                 return torch.cat(out).double().cpu().numpy()
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad)."""
+        """((B,), (B, dof)): d̂ (m) and ∂d̂/∂q (m/rad), all finite (else InputError)."""
+        with overflow_guard(self):
+            d, g = self._distance_and_grad(scene, q)
+        finite(self, d, g)
+        return d, g
+
+    def _distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
         if len(q) == 0:  # an empty batch: (0,) and (0, dof), the scene still checked
@@ -192,8 +219,23 @@ class GraphDistNetModel:
         whole-network pass (:mod:`.fused_net`) computes the gradient with d̂ instead: its
         backward follows each tile's forward in cache (about half the forward's cost again),
         cheaper than a second forward for the 70 % or so of planner calls that ask for it
-        (docs/decisions.md, 2026-12-02 fused2).
+        (docs/decisions.md, 2026-12-02 fused2). Both are checked finite (InputError).
         """
+        with overflow_guard(self):
+            d, grad = self._distance_deferred_grad(scene, q)
+        finite(self, d)
+
+        def gradient() -> np.ndarray:
+            with overflow_guard(self):
+                g = grad()
+            finite(self, d, g)
+            return g
+
+        return d, gradient
+
+    def _distance_deferred_grad(
+        self, scene: Scene, q: np.ndarray
+    ) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
         check_scene(scene, "planar", "a GraphDistNet-3D model (gdnplan.load_model of 3-D weights)")
         q = scene.robot.check_q(q)
         if len(q) == 0:

@@ -40,7 +40,9 @@ def load_graphdistnet3d(
         check_count(depth, len(tensors), name, path)  # else a huge network before the check
     check_count(len(config.readout) or 1, len(tensors), "readout", path)
     net = build_net(path, "GraphDistNet-3D", lambda: GraphDistNet3D(config), tensors)
-    return GraphDistNet3DModel(net, card, threads=threads, fused=fused)
+    model = GraphDistNet3DModel(net, card, threads=threads, fused=fused)
+    model.source = str(path)
+    return model
 
 
 def init_from_weights(net: GraphDistNet3D, path: Path | str) -> list[str]:

@@ -38,7 +38,8 @@ from ...graph3d import (
 )
 from ...limits import check_int
 from ...scene import check_scene
-from ..settings import MAX_CHUNK, check_dtype, check_flag, placed
+from ..outputs import finite, overflow_guard
+from ..settings import MAX_CHUNK, Checked, Fixed, check_dtype, check_flag, placed
 from ..threads import check_threads, torch_threads
 from . import fused3d
 from .fit import check_fits3d
@@ -124,6 +125,10 @@ class GraphDistNet3DModel:
     """A trained GraphDistNet-3D as a DistanceModel of :class:`~gdnplan.arm3d.Scene3D` s."""
 
     name = "graphdistnet3d"
+    threads = Checked(check_threads)  # settable later, checked as here (models/settings.py)
+    chunk = Checked(lambda chunk: check_int(chunk, "chunk", 1, MAX_CHUNK))
+    contact_offset = Checked(check_offset)
+    dtype = Fixed()
 
     def __init__(
         self,
@@ -138,14 +143,33 @@ class GraphDistNet3DModel:
     ):
         self.dtype = check_dtype(dtype)
         self.net = placed(net, torch.device("cpu"), self.dtype)
-        self.contact_offset = check_offset(contact_offset)
+        self.contact_offset = contact_offset
         self.config = net.config
         self.card = card or {}
-        self.self_collision = check_flag(self_collision, "self_collision")
-        self.chunk = check_int(chunk, "chunk", 1, MAX_CHUNK)
-        self.threads = check_threads(threads)
-        self.fused = self._check_fused(check_flag(fused, "fused", optional=True))
+        self.source: str | None = None  # the weights file it was loaded from (messages)
+        self.chunk, self.threads = chunk, threads
+        self._fused = self._check_fused(check_flag(fused, "fused", optional=True))
+        self.self_collision = self_collision  # (and the empty scene cache)
+
+    @property
+    def fused(self) -> bool:
+        """Whether the compiled pass runs (module docstring); set it to True, False or None."""
+        return self._fused
+
+    @fused.setter
+    def fused(self, fused: bool | None) -> None:
+        self._fused = self._check_fused(check_flag(fused, "fused", optional=True))
         self._scenes: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    @property
+    def self_collision(self) -> bool:
+        """Whether exact self-collision enters the distance (module docstring)."""
+        return self._self_collision
+
+    @self_collision.setter
+    def self_collision(self, on: bool) -> None:
+        self._self_collision = check_flag(on, "self_collision")
+        self._scenes = weakref.WeakKeyDictionary()
 
     def with_contact_offset(self, contact_offset: float) -> GraphDistNet3DModel:
         """This model with contact-only pairs offset by ``contact_offset`` (m); the copy shares
@@ -192,7 +216,13 @@ class GraphDistNet3DModel:
         return [slice(s, min(s + self.chunk, n)) for s in range(0, n, self.chunk)]
 
     def learned_distance(self, scene: Scene3D, q) -> np.ndarray:
-        """(B,) d̂ of the robot–obstacle distance alone (m)."""
+        """(B,) d̂ of the robot–obstacle distance alone (m), all finite (else InputError)."""
+        with overflow_guard(self):
+            d = self._learned_distance(scene, q)
+        finite(self, d)
+        return d
+
+    def _learned_distance(self, scene: Scene3D, q) -> np.ndarray:
         check_scene(scene, "3d", "a planar model (gdnplan.load_model of planar weights)")
         q = scene.robot.check_q(q)
         with torch_threads(self.threads):
@@ -208,7 +238,14 @@ class GraphDistNet3DModel:
         return torch.cat(out).double().numpy()
 
     def learned_distance_and_grad(self, scene: Scene3D, q) -> tuple[np.ndarray, np.ndarray]:
-        """(B,), (B, dof): d̂ of the robot–obstacle distance (m) and ∂d̂/∂q (m/rad)."""
+        """(B,), (B, dof): d̂ of the robot–obstacle distance (m) and ∂d̂/∂q (m/rad), all
+        finite (else InputError)."""
+        with overflow_guard(self):
+            d, g = self._learned_distance_and_grad(scene, q)
+        finite(self, d, g)
+        return d, g
+
+    def _learned_distance_and_grad(self, scene: Scene3D, q) -> tuple[np.ndarray, np.ndarray]:
         check_scene(scene, "3d", "a planar model (gdnplan.load_model of planar weights)")
         q = scene.robot.check_q(q)
         ds, gs = [], []
