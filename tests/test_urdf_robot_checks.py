@@ -361,3 +361,61 @@ def test_a_urdf_with_visuals_only_is_refused_saying_visuals_are_not_read(tmp_pat
     path.write_text(text.replace('<link name="forearm">', f'<link name="forearm">{visual}'))
     assert xml_collisions(path) == 0
     refused(path, kind, r"no collision geometry.*<visual> elements are not read")
+
+
+# -------------------------------------------------------------------- mesh sizes
+def big_stl(path: Path, triangles: int) -> Path:
+    """A binary STL of ``triangles`` random triangles in a 0.1 m cube (real facets)."""
+    rng = np.random.default_rng(0)
+    rec = np.zeros(triangles, dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = rng.random((triangles, 3, 3)) * 0.1
+    path.write_bytes(bytes(80) + triangles.to_bytes(4, "little") + rec.tobytes())
+    return path
+
+
+def _never_read(monkeypatch) -> None:
+    """Make any full read of a mesh file (coal's assimp loader) fail the test."""
+    import coal
+
+    def loader(*args, **kwargs):
+        raise AssertionError("the mesh file was read whole before it was refused")
+
+    monkeypatch.setattr(coal, "MeshLoader", loader)
+
+
+@KINDS
+def test_a_binary_stl_beyond_the_triangle_limit_is_refused_from_its_header(
+    tmp_path, kind, monkeypatch
+):
+    """Audit: a URDF mesh of 500 000 triangles (1.5 M vertices) was parsed whole by assimp
+    (seconds, hundreds of MB) before its vertex count was refused."""
+    from gdnplan.urdf_robot.meshes import MAX_MESH_TRIANGLES
+
+    big_stl(tmp_path / "big.stl", MAX_MESH_TRIANGLES + 1)
+    path = mutated(tmp_path, BOX, '<mesh filename="big.stl"/>')
+    _never_read(monkeypatch)
+    message = refused(path, kind, "link 'forearm'")
+    assert f"binary STL of {MAX_MESH_TRIANGLES + 1} triangles" in message and "big.stl" in message
+
+
+@KINDS
+@pytest.mark.parametrize("suffix", ["obj", "dae", "stl"])
+def test_a_mesh_file_beyond_the_byte_limit_is_refused_before_reading(
+    tmp_path, kind, monkeypatch, suffix
+):
+    from gdnplan.urdf_robot.meshes import MAX_MESH_BYTES
+
+    mesh = tmp_path / f"big.{suffix}"
+    with open(mesh, "wb") as f:  # sparse: the size alone matters
+        f.write(b"solid x\n" if suffix == "stl" else b"v 0 0 0\n")
+        f.truncate(MAX_MESH_BYTES + 1)
+    path = mutated(tmp_path, BOX, f'<mesh filename="big.{suffix}"/>')
+    _never_read(monkeypatch)
+    assert f"more than {MAX_MESH_BYTES}" in refused(path, kind, "link 'forearm'")
+
+
+def test_the_mesh_vertex_limit_is_the_hull_limit():
+    from gdnplan.arm3d.shapes import MAX_HULL_POINTS
+    from gdnplan.urdf_robot.meshes import MAX_MESH_VERTICES
+
+    assert MAX_MESH_VERTICES == MAX_HULL_POINTS

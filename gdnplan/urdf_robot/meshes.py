@@ -5,10 +5,14 @@ Each ``<mesh filename>`` is resolved as Pinocchio resolves it (``package://`` an
 paths against the package folders, then ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH``/share;
 ``file://`` and absolute paths as they are) and must be a regular file that assimp reads as a
 mesh (STL, OBJ, DAE, …), with at least one vertex, every vertex finite and, scaled, within
-``MAX_OFFSET`` m of the link frame. The file is read with an axis-aligned bounding-box tree,
-which computes nothing with the vertices: coal's default tree runs an eigen-decomposition on
-them and prints "eigen: too many iterations" for a NaN. Each failure is one InputError naming
-the file, the link and the mesh path.
+``MAX_OFFSET`` m of the link frame. Before assimp reads a file whole, its size is checked
+(:func:`check_mesh_size`): a binary STL's header gives its triangle count (at most
+:data:`MAX_MESH_TRIANGLES`), any mesh file at most :data:`MAX_MESH_BYTES` bytes, so a mesh far
+beyond the vertex limit of a hull (:data:`MAX_MESH_VERTICES`, ``arm3d.shapes.MAX_HULL_POINTS``,
+checked after reading) is refused without parsing it. The file is read with an axis-aligned
+bounding-box tree, which computes nothing with the vertices: coal's default tree runs an
+eigen-decomposition on them and prints "eigen: too many iterations" for a NaN. Each failure
+is one InputError naming the file, the link and the mesh path.
 """
 
 from __future__ import annotations
@@ -24,6 +28,17 @@ from ..errors import InputError
 from ..files import check_input_file
 from .stderr import stderr_captured
 from .xml_checks import MAX_OFFSET, mesh_elements, numbers, shown
+
+MAX_MESH_VERTICES = 100_000  # vertices of a mesh's hull: gdnplan.arm3d.shapes.MAX_HULL_POINTS
+# A closed triangle mesh of V vertices has about 2 V triangles: twice that is read at all (a
+# binary STL of 400 000 triangles, 20 MB, reads in about 1.5 s), more refused from the header.
+MAX_MESH_TRIANGLES = 4 * MAX_MESH_VERTICES
+# Any mesh file: 32 MiB (a text OBJ or DAE of 100 000 vertices with normals takes ~15 MB;
+# assimp reads 32 MiB of OBJ in about 5 s).
+MAX_MESH_BYTES = 32 << 20
+_STL_HEADER = 84  # bytes: 80 of text, then the triangle count (uint32, little-endian)
+_STL_TRIANGLE = 50  # bytes per triangle: normal, 3 vertices (float32), attribute (uint16)
+_SIMPLIFY = "simplify (decimate) the mesh or give its convex hull (only the hull is used)"
 
 
 def mesh_search_dirs(package_dirs: Sequence[str]) -> list[str]:
@@ -84,6 +99,7 @@ def mesh_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarray
     if not found.is_file():
         raise InputError(f"{where}: {found} is not a regular file (a device or a pipe)")
     check_input_file(found, where)  # at most MAX_INPUT_BYTES: assimp reads it whole
+    check_mesh_size(found, where)
     vertices = _read_vertices(found, scale, where)
     if len(vertices) == 0:
         raise InputError(f"{where}: {found} has no vertices")
@@ -96,6 +112,32 @@ def mesh_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarray
             f"(scale {scale}); give the mesh in metres or a scale"
         )
     return vertices
+
+
+def check_mesh_size(found: Path, where: str) -> None:
+    """InputError "<where>: …" when the mesh file ``found`` is too large to read (module
+    docstring): a binary STL whose header counts more than :data:`MAX_MESH_TRIANGLES`
+    triangles, any file of more than :data:`MAX_MESH_BYTES` bytes. Reads 84 bytes at most."""
+    try:
+        size = found.stat().st_size
+        with open(found, "rb") as f:
+            head = f.read(_STL_HEADER)
+    except OSError as e:
+        raise InputError(f"{where}: cannot read {found} ({e.strerror or e})") from e
+    if len(head) == _STL_HEADER:
+        triangles = int.from_bytes(head[80:], "little")
+        if size == _STL_HEADER + _STL_TRIANGLE * triangles and triangles > MAX_MESH_TRIANGLES:
+            raise InputError(
+                f"{where}: {found} is a binary STL of {triangles} triangles, more than "
+                f"{MAX_MESH_TRIANGLES} (a closed mesh of the {MAX_MESH_VERTICES}-vertex limit "
+                f"has about {2 * MAX_MESH_VERTICES}); {_SIMPLIFY}"
+            )
+    if size > MAX_MESH_BYTES:
+        raise InputError(
+            f"{where}: {found} has {size} bytes, more than {MAX_MESH_BYTES} "
+            f"({MAX_MESH_BYTES >> 20} MiB: a mesh of the {MAX_MESH_VERTICES}-vertex limit "
+            f"takes far less); {_SIMPLIFY}"
+        )
 
 
 def _read_vertices(found: Path, scale: Sequence[float], where: str) -> np.ndarray:
