@@ -125,3 +125,20 @@ def test_a_box_turned_by_quarter_turns_is_its_world_extents(turn, k):
     np.testing.assert_allclose(
         MODEL.distance(turned, q), MODEL.distance(Scene3D(scene.robot, same), q), atol=1e-12
     )
+
+
+@pytest.mark.parametrize(
+    ("changes", "field"),
+    [
+        ({"seconds": float("inf")}, "seconds"),  # trained for ever
+        ({"seconds": float("nan")}, "seconds"),  # trained nothing
+        ({"epochs": 1.5}, "epochs"),
+        ({"epochs": 1, "batch": 0}, "batch"),
+        ({"epochs": 1, "lr": 1e300}, "lr"),
+        ({"epochs": 1, "seed": -1}, "seed"),
+    ],
+)
+def test_bad_clearancenet3d_training_arguments_name_the_field(changes, field):
+    data = {"q": np.zeros((4, 6)), "boxes": np.zeros((4, 120)), "d": np.zeros(4)}
+    with pytest.raises(InputError, match=rf"^{field}: "):
+        train_clearancenet3d(data, 1.0, **changes)

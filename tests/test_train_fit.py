@@ -199,3 +199,11 @@ def test_a_checkpoint_without_a_best_state_keeps_the_key(tmp_path):
     state = new_state(1e-3)
     save_checkpoint(tmp_path / "c.safetensors", net, torch.optim.Adam(net.parameters()), state)
     assert state["best_state"] is None
+
+
+@pytest.mark.parametrize("lr", [1e300, 3.5e38, 11.0])
+def test_a_learning_rate_past_the_limit_is_refused(lr):
+    """Audit: --lr 1e300 passed the check and torch's Adam step raised "value cannot be
+    converted to type float without overflow" (gdnplan train: internal error, exit 3)."""
+    with pytest.raises(InputError, match=r"^lr: expected a finite learning rate in \[0, 10\]"):
+        FitConfig(lr=lr)

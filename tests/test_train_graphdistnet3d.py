@@ -158,3 +158,33 @@ def test_graphdistnet3d_reexports_the_concept_modules_names():
         for name in module.__all__:
             assert getattr(graphdistnet3d, name) is getattr(module, name), name
             assert name in graphdistnet3d.__all__
+
+
+@pytest.mark.parametrize(
+    ("changes", "field"),
+    [
+        ({"batch": 0}, "batch"),
+        ({"validate_every": 0}, "validate_every"),
+        ({"n_val": 0}, "n_val"),
+        ({"seed": -1}, "seed"),
+        ({"lr": 1e300}, "lr"),
+        ({"lr": float("nan")}, "lr"),
+        ({"min_lr": -1.0}, "min_lr"),
+        ({"min_lr": 1.0}, "min_lr"),  # above lr: nothing would train
+        ({"grad_weight": float("nan")}, "grad_weight"),
+        ({"contact_scale": 0.0}, "contact_scale"),
+    ],
+)
+def test_bad_3d_training_settings_name_the_field(changes, field):
+    """Audit: Train3DConfig took anything (batch 0, NaN weights, lr 1e300) and failed deep in
+    the loop, or trained nothing."""
+    with pytest.raises(InputError, match=rf"^{field}: "):
+        Train3DConfig(**changes)
+
+
+@pytest.mark.parametrize("budget", [None, float("inf"), float("nan"), -1.0])
+def test_a_run_that_could_never_end_is_refused(tmp_path, budget):
+    """Audit: min_lr = 0 without a time budget (or with an infinite one) looped for ever."""
+    c = Train3DConfig(lr=0.0, min_lr=0.0)
+    with pytest.raises(InputError, match="min_lr|time_budget"):
+        train3d(tmp_path / "t", tmp_path / "v", tmp_path / "run", c, time_budget=budget)

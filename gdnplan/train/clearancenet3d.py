@@ -4,6 +4,7 @@ squared error ((d̂ − f) / scale)², batches of ``batch``, for ``seconds`` of 
 
 from __future__ import annotations
 
+import math
 import time
 from pathlib import Path
 
@@ -11,7 +12,9 @@ import numpy as np
 import torch
 
 from ..errors import InputError
+from ..limits import check_int, is_number, shown
 from ..models.clearancenet3d import ClearanceNet3D, ClearanceNet3DConfig, box_vector
+from .fit import check_lr
 from .graphdistnet3d import read_shard, shard_files
 from .report import metrics
 
@@ -45,8 +48,14 @@ def train_clearancenet3d(
     two); (net, summary)."""
     if (seconds is None) == (epochs is None):
         raise InputError("train_clearancenet3d: give either seconds or epochs")
-    if epochs is not None and epochs < 1:
-        raise InputError(f"epochs: expected a positive number of epochs, got {epochs!r}")
+    if epochs is not None:
+        check_int(epochs, "epochs", 1)
+    elif not (is_number(seconds) and math.isfinite(seconds) and seconds > 0):
+        # nan trained nothing, inf for ever
+        raise InputError(f"seconds: expected a finite number of seconds > 0, got {shown(seconds)}")
+    check_int(batch, "batch", 1)
+    check_int(seed, "seed", 0)
+    check_lr(lr)
     torch.manual_seed(seed)
     net = ClearanceNet3D(ClearanceNet3DConfig(dof=data["q"].shape[1], scale=scale))
     q, o, d = (torch.as_tensor(data[k], dtype=torch.float32) for k in ("q", "boxes", "d"))

@@ -38,6 +38,9 @@ from .checkpoint import load_checkpoint, save_checkpoint
 CLOCKS = {"wall": time.perf_counter, "cpu": time.process_time}  # FitConfig.budget_clock
 PLATEAU = 3  # epochs without improvement before the learning rate is halved
 COUNTS = {"batch": 1, "epochs": 1, "patience": 1, "seed": 0}  # integer fields: least value
+# Adam moves every weight by about lr per step: past 10 (weights are O(1)) nothing trains, and
+# past float32's range (3.4e38) torch's step raised "value cannot be converted to type float".
+MAX_LR = 10.0
 
 
 @dataclass(frozen=True)
@@ -76,8 +79,7 @@ def check_schedule(c: FitConfig) -> None:
     """InputError naming the first field of ``c`` that is not usable."""
     for name, least in COUNTS.items():
         check_int(getattr(c, name), name, least)
-    if not (is_number(c.lr) and math.isfinite(c.lr) and c.lr >= 0):
-        raise InputError(f"lr: expected a finite learning rate ≥ 0, got {shown(c.lr)}")
+    check_lr(c.lr)
     budget = c.time_budget
     if budget is not None and not (is_number(budget) and math.isfinite(budget) and budget > 0):
         raise InputError(
@@ -93,6 +95,16 @@ def check_schedule(c: FitConfig) -> None:
         raise InputError(f"device: expected cpu or cuda, got {c.device!r}")
     if dev.type == "cuda" and (dev.index or 0) >= torch.cuda.device_count():
         raise InputError(f"device: {c.device} is not available on this machine; use cpu")
+
+
+def check_lr(lr: object, name: str = "lr") -> float:
+    """``lr`` when it is a learning rate in [0, :data:`MAX_LR`], else InputError naming it."""
+    if not (is_number(lr) and math.isfinite(lr) and 0 <= lr <= MAX_LR):
+        raise InputError(
+            f"{name}: expected a finite learning rate in [0, {MAX_LR:g}] (Adam steps every "
+            f"weight by about lr; 1e-3 is the default), got {shown(lr)}"
+        )
+    return float(lr)
 
 
 def validation_split(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:

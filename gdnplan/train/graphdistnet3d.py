@@ -43,6 +43,8 @@ from ..arm3d.scene3d import workspace_radius
 from ..data.samples3d import env_robot3d
 from ..errors import InputError
 from ..graph3d import robot_graph3d
+from ..limits import MAX_SEED, check_int, is_number, shown
+from ..models.fields import check_real
 from ..models.graphdistnet3d import (
     GraphDistNet3D,
     GraphDistNet3DConfig,
@@ -52,6 +54,7 @@ from ..models.graphdistnet3d import (
 from ..models.weights import read_card
 from .batch3d import CLOUD_K, Batch3D, make_batch
 from .checkpoint import load_checkpoint, save_checkpoint
+from .fit import check_lr
 from .loss import GraphDistNetLoss, distance_loss, gradient_loss
 from .report3d import evaluate3d, export_weights
 from .shard_stream3d import batches, read_shard, shard_files, split_env
@@ -72,6 +75,18 @@ class Train3DConfig:
     grad_weight: float = 0.1
     contact_weight: float = 2.0
     contact_scale: float = 0.02
+
+    def __post_init__(self) -> None:
+        """InputError naming the first unusable field: counts are integers ≥ 1 (seed ≥ 0),
+        0 ≤ min_lr ≤ lr ≤ MAX_LR, weights ≥ 0 and contact_scale > 0, all finite."""
+        for name in ("batch", "n_val", "validate_every"):
+            check_int(getattr(self, name), name, 1)
+        check_int(self.seed, "seed", 0, MAX_SEED)
+        check_lr(self.lr)
+        check_real("min_lr", self.min_lr, 0.0, self.lr)
+        for name in ("grad_weight", "contact_weight"):
+            check_real(name, getattr(self, name), 0.0, 1e6)
+        check_real("contact_scale", self.contact_scale, 1e-6, 1e3, " m")
 
 
 def network_config(init: Path | str | None = None, min_readout: bool = False):
@@ -97,6 +112,10 @@ def train3d(
     """Train (or resume) a run in ``run_dir`` for ``time_budget`` seconds (None: until the
     learning rate falls below ``min_lr``); returns the loop state (log, best, position). A new
     run's network starts from the weights ``init`` (:func:`init_from_weights`) if given."""
+    if time_budget is not None and not (is_number(time_budget) and 0 <= time_budget < math.inf):
+        raise InputError(f"time_budget: expected seconds ≥ 0 or None, got {shown(time_budget)}")
+    if config.min_lr == 0 and time_budget is None:  # the halved rate reaches 0, and 0 ≥ 0
+        raise InputError("min_lr: 0 never ends a run without a time budget; give one or min_lr > 0")
     torch.set_num_threads(1)
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
