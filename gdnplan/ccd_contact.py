@@ -13,12 +13,15 @@ with the bisection proof of :func:`gdnplan.ccd.certify_path` (and
     (d̲(q_a) + d̲(q_b) − δ(q_a, q_b)) / 2 > −a,
 
 d̲ coal's distance minus its error allowance (:func:`gdnplan.ccd.proven_distance`, about
-2 µm at contact) and δ the largest motion of any robot point between the ends. At the contact
-d̲ ≈ −2 µm, so the first proven piece is short (δ < 2a − 4 µm), and as the path leaves the
-contact at a rate v ≤ δ per unit of s, d̲ grows and the pieces grow geometrically: a lift
-of a few millimetres is proven with tens of coal calls. A path that moves *into* the contact
-(d decreasing) is not proven (it is not a lift). Contact-only self pairs of a 3-D robot must
-still stay apart (d > 0), as in :func:`gdnplan.arm3d.certify_path3d`.
+2 µm at contact; in 3-D, a pair coal finds closer than 0.1 mm, overlapping ones above all,
+gets the translated bound of :mod:`gdnplan.arm3d.depth3d`, since coal's EPA depth on curved
+shapes stops short by more than that slack) and δ the largest motion of any robot point
+between the ends. At the contact d̲ ≈ −2 µm, so the first proven piece is short
+(δ < 2a − 4 µm), and as the path leaves the contact at a rate v ≤ δ per unit of s, d̲ grows
+and the pieces grow geometrically: a lift of a few millimetres is proven with tens of coal
+calls. A path that moves *into* the contact (d decreasing) is not proven (it is not a lift).
+Contact-only self pairs of a 3-D robot must still stay apart (d > 0), as in
+:func:`gdnplan.arm3d.certify_path3d`.
 
 ``allowance`` must exceed coal's error at contact for a proof to exist; the default
 :data:`CONTACT_ALLOWANCE` (10 µm) is five times it and far below any mechanical tolerance.
@@ -31,6 +34,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .arm3d.depth3d import contact_distances3d
 from .ccd import MAX_CHECKS, MAX_SPLITS, Certificate, certify_by_bisection, check_path
 from .errors import InputError
 from .exact import exact_distance, motion_bound_of, swept_radius_of
@@ -65,7 +69,9 @@ def certify_from_contact(
 
     Returns:
         a :class:`gdnplan.ccd.Certificate`: ``ok`` with a proof on every piece, then
-        ``lower_bound`` > −allowance; ``min_distance`` the smallest coal distance checked.
+        ``lower_bound`` > −allowance; ``min_distance`` the smallest distance checked (coal's,
+        or in 3-D the translated bound of a pair closer than 0.1 mm plus coal's slack,
+        :func:`gdnplan.arm3d.depth3d.contact_distances3d`, when that is smaller).
     """
     check_scene(scene, "any")
     allowance = check_number(allowance, "allowance", strict=True)
@@ -80,7 +86,7 @@ def certify_from_contact(
     q_path = check_path(robot, q_path)
     return certify_by_bisection(
         q_path,
-        lambda q: exact_distance(scene, q, margin=-allowance),
+        _distance(scene, -allowance),
         lambda qa, qb: motion_bound_of(robot, qa, qb),
         -allowance,
         math.inf,
@@ -89,6 +95,16 @@ def certify_from_contact(
         max_checks,
         swept_radius_of(scene),
     )
+
+
+def _distance(scene: Scene | Scene3D, margin: float):
+    """q (B, dof) → (B,) distances whose ``proven_distance`` is a proven lower bound also where
+    pairs overlap: a 3-D scene's overlapping pairs get the translated bound of
+    :mod:`gdnplan.arm3d.depth3d` (coal's EPA depth on curved shapes stops short by more than
+    its slack); planar prisms are polytopes, whose EPA depth (tolerance 1e-9) is exact."""
+    if isinstance(scene, Scene):
+        return lambda q: exact_distance(scene, q, margin=margin)
+    return lambda q: contact_distances3d(scene, q, margin)
 
 
 def contact_detail(cert: Certificate, allowance: float = CONTACT_ALLOWANCE) -> str:

@@ -72,6 +72,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "arm3d.narrow3d",  # the pair table and coal's narrow phase of one pair
             "arm3d.gradient3d",  # the exact gradient of a pair's distance
             "arm3d.ccd3d",
+            "arm3d.depth3d",  # proven bounds on overlapping pairs (the contact certificate)
             "arm3d.ik3d_checks",  # the pose IK's settings and tool positions
             "arm3d.ik3d",
             "arm3d.held",
