@@ -20,9 +20,15 @@ def is_exact(model: DistanceModel) -> bool:
 
 
 def straight_line(start: np.ndarray, goal: np.ndarray, n: int) -> np.ndarray:
-    """(n, dof) evenly spaced joint-space interpolation from start to goal."""
+    """(n, dof) evenly spaced joint-space interpolation from start to goal, ending exactly at
+    goal for n ≥ 2 (start + 1 · (goal − start) can be an ulp off it: a plan whose straight line
+    was certified then ended beside its goal, and the 3-D fetch's pieces, stacked on the
+    promise that each ends where the next begins, joined by a segment no certificate saw)."""
     s = np.linspace(0.0, 1.0, n)[:, None]
-    return start + s * (goal - start)
+    line = start + s * (goal - start)
+    if n >= 2:
+        line[-1] = goal
+    return line
 
 
 def _path_parameters(splits: np.ndarray) -> np.ndarray:
