@@ -173,7 +173,10 @@ def _planned(fetch: Fetch3D, name: str, margin: float, collision="coal") -> Stag
     t0 = time.perf_counter()
     problems = stage_problems(fetch, name, margin)
     runs = [plan(p, collision=collision) for p in problems]
-    ok = all(r.success for r in runs)
+    # the stacked path drops each next piece's first row: it is certified only when that row
+    # is exactly the previous piece's last (a plan ends exactly at its joint goal)
+    joined = all(np.array_equal(a.q[-1], b.q[0]) for a, b in itertools.pairwise(runs))
+    ok = all(r.success for r in runs) and joined
     q = np.vstack([runs[0].q, *(r.q[1:] for r in runs[1:])])
     lower = min(r.min_distance for r in runs) if ok else -np.inf
     reasons = dict.fromkeys(r.reason for r in runs)

@@ -38,6 +38,10 @@ class Plan:
         min_distance: proven lower bound on the coal signed distance over the whole continuous
             path (m; the certificate of :func:`gdnplan.ccd.certify_path`, within 1 mm of the
             path's true minimum); −inf when the certificate could not prove the path free.
+            3-D: the bound of obstacle and ordinary self pairs; a contact-only self pair is
+            only proven ≥ min_distance − clearance (:mod:`gdnplan.arm3d.ccd3d`: the shipped
+            UR5e's forearm–wrist pairs stay closer than any useful margin), so
+            ``signed_distance3d``, which counts those pairs too, can be smaller.
         sampled_min_distance: smallest coal distance over the configurations the certificate
             checked (m): an upper bound on the path's minimum (the true minimum lies in
             [min_distance, sampled_min_distance]).
