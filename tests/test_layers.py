@@ -47,6 +47,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ur5e.layout",  # fetch layouts: plane polygons and tcp targets, no distances
             "arm3d.shapes",
             "arm3d.pairs",
+            "arm3d.link_shape",  # one link's collision shape, checked when made
             "arm3d.robot3d",
             "arm3d.builtin",
             "arm3d.scene3d",

@@ -19,7 +19,6 @@ oᵢ, world axes); :meth:`Robot3D.point_jacobian` returns J_p = J_v − [p − o
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import coal
@@ -35,30 +34,9 @@ from ..urdf_robot.joint_limits import check_joint_limits
 from ..urdf_robot.load import check_mimic, urdf_path
 from ..urdf_robot.locking import lock_mimics, set_locked
 from ..urdf_robot.spec import check_folders, check_locked, check_names
+from .link_shape import LinkShape
 from .pairs import contact_only_mask, self_collision_pairs
 from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
-
-
-@dataclass(frozen=True)
-class LinkShape:
-    """One collision shape of a robot link.
-
-    Attributes:
-        name: the geometry's name (Pinocchio's geometry object name).
-        link: the URDF link carrying it.
-        body: the joint index (reduced model) the link moves with; 0 = fixed base.
-        shape: the coal shape, in its own frame.
-        placement: (4, 4) homogeneous placement of the shape frame in the body's joint frame.
-        center: (3,) bounding-sphere centre in the shape frame (m); radius: its radius (m).
-    """
-
-    name: str
-    link: str
-    body: int
-    shape: coal.CollisionGeometry
-    placement: np.ndarray
-    center: np.ndarray
-    radius: float
 
 
 class Robot3D:
@@ -91,6 +69,14 @@ class Robot3D:
         self.model = model
         self.data = model.createData()
         self.shapes = tuple(shapes)
+        for s in self.shapes:
+            if not isinstance(s, LinkShape):
+                raise InputError(f"shapes: expected LinkShape items, got {type(s).__name__}")
+            if s.body >= model.njoints:
+                raise InputError(
+                    f"shapes: {s.name!r} hangs from body {s.body}, but the model has "
+                    f"{model.njoints} joints (bodies 0 … {model.njoints - 1})"
+                )
         self.links = tuple(dict.fromkeys(s.link for s in self.shapes))
         self.shape_link = np.array([self.links.index(s.link) for s in self.shapes], dtype=int)
         self.shape_body = np.array([s.body for s in self.shapes], dtype=int)
