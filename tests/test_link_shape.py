@@ -84,3 +84,11 @@ def test_a_shape_on_a_body_the_model_lacks_is_refused():
     shape = LinkShape("cube", "link0", 5, CUBE, np.eye(4), center, radius)
     with pytest.raises(InputError, match=r"hangs from body 5"):
         Robot3D("turner", turner(), [shape], np.zeros((0, 2), int), {})
+
+
+@pytest.mark.parametrize("pairs", [[[0, 1]], [[-1, 0]]])
+def test_self_pairs_name_shapes_the_robot_has(pairs):
+    center, radius = bounding_sphere(CUBE)
+    shape = LinkShape("cube", "link0", 1, CUBE, np.eye(4), center, radius)
+    with pytest.raises(InputError, match=r"self_pairs"):
+        Robot3D("turner", turner(), [shape], np.array(pairs), {})

@@ -81,6 +81,10 @@ class Robot3D:
         self.shape_link = np.array([self.links.index(s.link) for s in self.shapes], dtype=int)
         self.shape_body = np.array([s.body for s in self.shapes], dtype=int)
         self.self_pairs = np.asarray(self_pairs, dtype=int).reshape(-1, 2)
+        if np.any(self.self_pairs < 0) or np.any(self.self_pairs >= len(self.shapes)):
+            raise InputError(  # a negative index named another shape silently
+                f"self_pairs: shape indices must lie in [0, {len(self.shapes) - 1}]"
+            )
         self.disabled = dict(disabled)
         self.contact_only = frozenset(frozenset(p) for p in contact_only)
         self.self_contact_only = contact_only_mask(self.shapes, self.self_pairs, self.contact_only)
