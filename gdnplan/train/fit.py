@@ -38,9 +38,10 @@ from .checkpoint import load_checkpoint, save_checkpoint
 CLOCKS = {"wall": time.perf_counter, "cpu": time.process_time}  # FitConfig.budget_clock
 PLATEAU = 3  # epochs without improvement before the learning rate is halved
 COUNTS = {"batch": 1, "epochs": 1, "patience": 1, "seed": 0}  # integer fields: least value
-# Adam moves every weight by about lr per step: past 10 (weights are O(1)) nothing trains, and
-# past float32's range (3.4e38) torch's step raised "value cannot be converted to type float".
-MAX_LR = 10.0
+# Adam moves every weight by about lr per step: nothing trains above ~1 (weights are O(1); a
+# test wrecks a network with 50 on purpose), and past float32's range (3.4e38) torch's step
+# raised "value cannot be converted to type float without overflow".
+MAX_LR = 1e3
 
 
 @dataclass(frozen=True)
