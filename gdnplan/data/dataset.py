@@ -32,6 +32,7 @@ from ..flags import check_flag
 from ..robot import Robot, load_robot
 from ..scene import ENV_ROBOT, Scene, make_scene
 from ..ur5e import GRIPPER_STATES
+from .shard_read import check_planar, read_npz
 
 SPLITS = {"train": (0, 50_000), "test": (1, 5_000)}  # split -> (seed, paper's size)
 DATA_DIR = Path("data")  # default dataset root, relative to the working directory
@@ -120,7 +121,8 @@ def variant_robot(gripper: int, stick_length: float = 0.0, stick_width: float = 
 
 
 def load(path: Path | str, n: int | None = None) -> Dataset:
-    """Load a split (a directory of shards, or one ``.npz``), at most its first n samples."""
+    """Load a split (a directory of shards, or one ``.npz``), at most its first n samples;
+    every shard checked as it is read (:mod:`.shard_read`), InputError naming the file."""
     path = Path(path)
     files = sorted(path.glob("shard_*.npz")) if path.is_dir() else [path] * path.exists()
     files = [f for f in files if not f.name.endswith(".tmp.npz")]
@@ -129,12 +131,26 @@ def load(path: Path | str, n: int | None = None) -> Dataset:
     parts = []
     total = 0
     for f in files:
-        with np.load(f) as z:
-            parts.append({k: z[k] for k in ("env", *FIELDS, *ROBOT_FIELDS) if k in z})
+        arrays = read_npz(f)
+        check_planar(arrays, f, FIELDS)
+        parts.append({k: arrays[k] for k in ("env", *FIELDS, *ROBOT_FIELDS) if k in arrays})
+        _check_same_split(parts[0], parts[-1], files[0], f)
         total += len(parts[-1]["q"])
         if n is not None and total >= n:
             break
     return _join(parts, n)
+
+
+def _check_same_split(first: dict, part: dict, first_file: Path, file: Path) -> None:
+    """InputError unless the shard arrays ``part`` (of ``file``) have the environment and
+    joint count of ``first`` (of ``first_file``)."""
+    a, b = (str(first["env"]), first["q"].shape[1]), (str(part["env"]), part["q"].shape[1])
+    if a != b:
+        raise InputError(
+            f"data: shard {file} holds samples of environment {b[0]!r} ({b[1]} joints), "
+            f"{first_file.name} of {a[0]!r} ({a[1]} joints): a split folder holds one "
+            "environment's shards; move the others out"
+        )
 
 
 def concat(datasets: list[Dataset]) -> Dataset:

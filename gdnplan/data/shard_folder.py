@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 from collections.abc import Callable, Mapping, Sequence
 from multiprocessing import get_context
 from pathlib import Path
@@ -24,6 +25,7 @@ from tqdm import tqdm
 from ..errors import InputError
 from ..files import write_text
 from ..limits import check_int, is_number
+from .shard_read import read_npz
 
 MANIFEST = "manifest.json"
 MAX_SPLIT = 10**8  # samples of one split: ~15 GB of planar 2-DoF shards, ~110 GB of (e)'s
@@ -99,11 +101,12 @@ def check_manifest(out_dir: Path, settings: Mapping, options: Mapping[str, str])
 
 
 def shard_size(path: Path) -> int | None:
-    """Samples in the shard ``path`` (None when it cannot be read: it is made again)."""
+    """Samples in the shard ``path`` (None when it cannot be read, e.g. a truncated copy, or
+    fails :func:`.shard_read.read_npz`'s checks: it is made again)."""
     try:
-        with np.load(path) as z:
-            return len(z["q"])
-    except (OSError, ValueError, KeyError):
+        arrays = read_npz(path)
+        return len(arrays["q"]) if "q" in arrays and arrays["q"].ndim else None
+    except InputError:
         return None
 
 
@@ -135,6 +138,15 @@ def run_jobs(
         for job in jobs:
             bar.update(write(job))
         return
-    with get_context("fork").Pool(workers) as pool:
+    # Ctrl-C reaches the whole process group: the workers ignore it (each printed a
+    # KeyboardInterrupt traceback, and the pool waited for their shards, ~40 s of (d)), this
+    # process raises KeyboardInterrupt and the pool's exit terminates them; the shard being
+    # written stays a temp file (atomic_path), never a half shard.
+    with get_context("fork").Pool(workers, initializer=_ignore_sigint) as pool:
         for k in pool.imap_unordered(write, jobs):
             bar.update(k)
+
+
+def _ignore_sigint() -> None:
+    """A worker's initializer: SIGINT ignored (the parent handles Ctrl-C)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..data.shard_read import FIX, read_npz
 from ..errors import InputError
 
 
@@ -24,8 +25,12 @@ def shard_files(folder: Path | str) -> list[Path]:
 
 
 def read_shard(path: Path) -> dict:
-    with np.load(path) as z:
-        return {k: z[k] for k in z.files}
+    """The arrays of the 3-D shard ``path``, checked as :func:`gdnplan.data.shard_read.read_npz`
+    checks them (a readable archive of finite numbers; InputError naming the file)."""
+    arrays = read_npz(path)
+    if "d" not in arrays or arrays["d"].ndim != 1:
+        raise InputError(f"data: shard {path} has no distances 'd' (n,); {FIX}")
+    return arrays
 
 
 def batches(files: list[Path], batch: int, seed: int, epoch: int, skip: int = 0):
@@ -34,7 +39,7 @@ def batches(files: list[Path], batch: int, seed: int, epoch: int, skip: int = 0)
     step = 0
     for f in order:
         shard = None
-        n = int(np.load(files[f])["d"].shape[0]) if step + 1 <= skip else None
+        n = len(read_shard(files[f])["d"]) if step + 1 <= skip else None
         if n is not None:
             count = -(-n // batch)
             if step + count <= skip:
