@@ -46,6 +46,16 @@ class OutputError(GdnplanError):
     file, a parent that is not a directory, a read-only directory, a full disk."""
 
 
+def numba_environment_error(error: ValueError) -> InputError:
+    """The InputError of numba refusing its environment variables at import (e.g.
+    ``NUMBA_NUM_THREADS=0``: "Number of threads specified must be > 0."), which was an
+    internal error of the first learned model loaded."""
+    return InputError(
+        f"NUMBA_NUM_THREADS / NUMBA_* environment: numba refuses it ({error}); unset the "
+        "variable or give a valid value (NUMBA_NUM_THREADS: a positive integer)"
+    )
+
+
 def did_you_mean(name: object, choices: Iterable[str]) -> str:
     """`` (did you mean 'x'?)`` naming the choice closest to ``name`` (difflib, ratio ≥ 0.6),
     else ""; for the messages of unknown names and keys. A name that is no string, or longer

@@ -122,3 +122,21 @@ def test_progress_handler_is_detached_after_a_command(capsys):
     _plan(capsys)
     gp.plan(gp.Problem.from_toml(SQUARE), collision="coal")  # the library alone prints nothing
     assert capsys.readouterr().err == ""
+
+
+def test_a_numba_environment_numba_refuses_is_one_input_error():
+    """Audit: NUMBA_NUM_THREADS=0 made numba's import raise ValueError inside the first learned
+    model loaded (`gdnplan plan … --collision graphdistnet`: internal error, exit 3)."""
+    import os
+
+    code = (
+        "import gdnplan as gp\n"
+        "try:\n"
+        "    gp.load_model('d')\n"
+        "except gp.InputError as e:\n"
+        "    print('refused:', e)\n"
+    )
+    env = {**os.environ, "NUMBA_NUM_THREADS": "0"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("refused: NUMBA_NUM_THREADS") and "positive integer" in out.stdout

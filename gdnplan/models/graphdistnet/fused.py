@@ -31,6 +31,7 @@ from collections.abc import Iterator
 import numpy as np
 import torch
 
+from ...errors import numba_environment_error
 from .layers import LEAKY_SLOPE
 
 try:
@@ -39,6 +40,8 @@ try:
     from threadpoolctl import ThreadpoolController
 except ImportError:  # the reference path serves (GraphDistNetModel's default)
     numba = None
+except ValueError as e:  # numba refuses its environment at import (NUMBA_NUM_THREADS=0)
+    raise numba_environment_error(e) from e
 
 AVAILABLE = numba is not None
 TILE_ROWS = 4096  # edge rows per tile (3 N per configuration): 512 kB per buffer, in L2

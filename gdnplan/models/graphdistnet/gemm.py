@@ -30,12 +30,16 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ...errors import numba_environment_error
+
 try:
     import numba
     from llvmlite import binding
     from numba import types
 except ImportError:  # the fused kernels are off without numba (fused.AVAILABLE)
     numba = None
+except ValueError as e:  # numba refuses its environment at import (NUMBA_NUM_THREADS=0)
+    raise numba_environment_error(e) from e
 
 __all__ = ["BACKEND", "mm"]
 
