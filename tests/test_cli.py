@@ -146,12 +146,33 @@ def test_generate_then_train_writes_loadable_weights(tmp_path):
             "--init: missing.safetensors does not exist",
         ),
         (["train", "--env", "a", "--compile", "--set", "grad_weight=0.1"], "double backward"),
+        # audit: 3-D weights were "--set: unknown GraphDistNet options ['length', 'rim']"
+        (["train", "--env", "a", "--init", "ur5e_storage3d"], "holds 'graphdistnet3d' weights"),
+        (["train", "--env", "a", "--init", "clearancenet_b"], "holds 'clearancenet' weights"),
     ],
 )
 def test_train_and_generate_reject_bad_options(args, message):
     result = runner.invoke(app, args)
     assert result.exit_code != 0
     assert message in str(result.exception) or message in result.output
+
+
+@pytest.mark.parametrize(("value", "message"), [(float("nan"), "NaN or infinite"), (1e30, "1e+06")])
+def test_train_refuses_init_weights_that_cannot_train(tmp_path, value, message):
+    """Audit: --init weights of NaN or huge values trained an epoch and were reported as a
+    run that "diverged at epoch 0: lower the learning rate"."""
+    from safetensors.torch import load_file
+
+    from gdnplan.assets import weights_file
+    from gdnplan.models.weights import read_card, write_weights
+
+    src = weights_file("a")
+    tensors = load_file(str(src))
+    tensors[next(iter(tensors))].view(-1)[0] = value
+    path = write_weights(tmp_path / "bad.safetensors", tensors, read_card(src))
+    result = runner.invoke(app, ["train", "--env", "a", "--init", str(path)])
+    assert result.exit_code != 0
+    assert message in str(result.exception) and "bad.safetensors" in str(result.exception)
 
 
 def test_plan_rejects_zero_threads():

@@ -219,6 +219,7 @@ def _graphdistnet_run(preset, set_, init, schedule, n_train, extra, compile):
     if init is None:
         base = PRESETS[preset or "smooth"]().to_dict()
     else:
+        check_init(init)
         base = card_settings(init)
     try:
         network, loss = split_config(base | overrides)
@@ -227,3 +228,21 @@ def _graphdistnet_run(preset, set_, init, schedule, n_train, extra, compile):
             raise InputError(f"--set: {e}") from e
         raise InputError(f"--set: a value of the wrong type in {set_} ({e})") from e
     return TrainConfig(network, loss, schedule, n_train, tuple(extra), init, compile)
+
+
+def check_init(path) -> None:
+    """InputError unless the weights ``path`` of ``--init`` are planar GraphDistNet weights
+    whose tensors load: finite, within :data:`gdnplan.models.outputs.MAX_WEIGHT` (3-D weights
+    were refused as "--set: unknown GraphDistNet options ['length', 'rim']", NaN or huge ones
+    as a training that "diverged at epoch 0")."""
+    from ..models.checks import load_tensors
+    from ..models.outputs import check_magnitudes
+    from ..models.weights import read_card
+
+    model = read_card(path, "--init").get("model")
+    if model != "graphdistnet":
+        raise InputError(
+            f"--init: {path} holds {model!r} weights; gdnplan train fine-tunes planar "
+            "GraphDistNet weights (a card of model 'graphdistnet', e.g. the shipped 'd')"
+        )
+    check_magnitudes(path, load_tensors(path, "--init"))
