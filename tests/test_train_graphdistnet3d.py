@@ -186,5 +186,5 @@ def test_bad_3d_training_settings_name_the_field(changes, field):
 def test_a_run_that_could_never_end_is_refused(tmp_path, budget):
     """Audit: min_lr = 0 without a time budget (or with an infinite one) looped for ever."""
     c = Train3DConfig(lr=0.0, min_lr=0.0)
-    with pytest.raises(InputError, match="min_lr|time_budget"):
+    with pytest.raises(InputError, match=r"min_lr|time_budget"):
         train3d(tmp_path / "t", tmp_path / "v", tmp_path / "run", c, time_budget=budget)
