@@ -146,6 +146,15 @@ def shown(value: object, limit: int = 40) -> str:
     return text if len(text) <= limit else f"{text[:limit]}…"
 
 
+def read_only(value) -> np.ndarray:
+    """A read-only float64 copy of ``value``: geometry that caches (coal shapes, lever arms,
+    checkers) is built from such arrays, so an in-place change (``obstacle += offset``) raises
+    instead of leaving a certificate to run on the geometry as it was."""
+    out = np.array(value, dtype=float)
+    out.setflags(write=False)
+    return out
+
+
 def is_integer(value: object) -> bool:
     """An int or numpy integer (any :class:`numbers.Integral`), not a bool."""
     return isinstance(value, numbers.Integral) and not isinstance(value, bool)

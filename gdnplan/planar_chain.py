@@ -22,6 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .limits import read_only
+
 
 def rot2(theta: np.ndarray) -> np.ndarray:
     """Rotation matrices of angles ``theta`` (...,) -> (..., 2, 2)."""
@@ -45,6 +47,10 @@ class PlanarChain:
 
     joint_origins: np.ndarray
     joint_signs: np.ndarray
+
+    def __post_init__(self) -> None:  # read-only: the lever arms are cached from them
+        object.__setattr__(self, "joint_origins", read_only(self.joint_origins))
+        object.__setattr__(self, "joint_signs", read_only(self.joint_signs))
 
     @property
     def dof(self) -> int:

@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import InputError
-from .limits import check_int
+from .limits import check_int, read_only
 from .planar_chain import PlanarChain, cross_z, rot2
 from .registry import ROBOTS, options_of
 from .robot_checks import as_batch, check_joint_range, check_seed, first_outside, make_rng
@@ -47,6 +47,10 @@ class LinkPolygon:
     vertices0: np.ndarray
     vertices_frame: np.ndarray
 
+    def __post_init__(self) -> None:  # read-only: the checkers and lever arms cache them
+        object.__setattr__(self, "vertices0", read_only(self.vertices0))
+        object.__setattr__(self, "vertices_frame", read_only(self.vertices_frame))
+
 
 @dataclass(frozen=True)
 class Plane:
@@ -54,6 +58,10 @@ class Plane:
 
     origin: np.ndarray
     axes: np.ndarray  # (2, 3), orthonormal rows
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "origin", read_only(self.origin))
+        object.__setattr__(self, "axes", read_only(self.axes))
 
     @property
     def normal(self) -> np.ndarray:
@@ -95,8 +103,8 @@ class Robot:
 
     def __post_init__(self) -> None:
         lower, upper = check_joint_range(self.lower, self.upper, self.model.nq, "joint limits")
-        object.__setattr__(self, "lower", lower)
-        object.__setattr__(self, "upper", upper)
+        object.__setattr__(self, "lower", read_only(lower))
+        object.__setattr__(self, "upper", read_only(upper))
 
     # ---------------------------------------------------------------- structure
     @property
@@ -128,17 +136,21 @@ class Robot:
     @cached_property
     def node_polygon(self) -> np.ndarray:
         """(N,) index of the polygon each node (vertex) belongs to."""
-        return np.concatenate([np.full(len(p.vertices0), i) for i, p in enumerate(self.polygons)])
+        out = np.concatenate([np.full(len(p.vertices0), i) for i, p in enumerate(self.polygons)])
+        out.setflags(write=False)  # the lever arms are cached from it (gdnplan.ccd)
+        return out
 
     @cached_property
     def node_body(self) -> np.ndarray:
         """(N,) body index of each node."""
-        return np.array([self.polygons[i].body for i in self.node_polygon])
+        out = np.array([self.polygons[i].body for i in self.node_polygon])
+        out.setflags(write=False)
+        return out
 
     @cached_property
     def nodes0(self) -> np.ndarray:
         """(N, 2) node positions at q = 0."""
-        return np.concatenate([p.vertices0 for p in self.polygons])
+        return read_only(np.concatenate([p.vertices0 for p in self.polygons]))
 
     @property
     def n_nodes(self) -> int:

@@ -34,7 +34,7 @@ from .geometry import (
     limit_vertices,
     square,
 )
-from .limits import check_int
+from .limits import check_int, read_only
 from .registry import SCENES
 from .robot import Robot, factory_options, load_robot, robot_names, robot_options
 from .scene_checks import (
@@ -77,12 +77,17 @@ class Scene:
 
     def __post_init__(self) -> None:
         check_robot(self.robot)
-        object.__setattr__(self, "obstacles", check_obstacles(self.obstacles, self.robot))
+        obstacles = check_obstacles(self.obstacles, self.robot)
+        # read-only copies: the coal checker and the parts are built from them once, so an
+        # in-place change (obstacle += offset) must raise, not leave them as they were
+        object.__setattr__(self, "obstacles", tuple(read_only(o) for o in obstacles))
 
     @cached_property
     def obstacle_parts(self) -> tuple[np.ndarray, ...]:
         """Convex CCW parts of all obstacles (what coal sees)."""
-        return tuple(part for poly in self.obstacles for part in convex_decomposition(poly))
+        return tuple(
+            read_only(part) for poly in self.obstacles for part in convex_decomposition(poly)
+        )
 
     @cached_property
     def part_owner(self) -> np.ndarray:

@@ -9,7 +9,7 @@ import coal
 import numpy as np
 
 from ..errors import InputError
-from ..limits import check_int, is_number
+from ..limits import check_int, is_number, read_only
 from .shapes import as_pose, as_vector, bounding_sphere, check_shape
 
 
@@ -60,6 +60,9 @@ class LinkShape:
                 f"its shape (its bounding sphere: centre {center.round(6).tolist()}, radius "
                 f"{radius:.6g} m); use gdnplan.arm3d.shapes.bounding_sphere"
             )
+        # read-only copies: the lever arms and the kinematics are cached from them
+        object.__setattr__(self, "placement", read_only(tf))
+        object.__setattr__(self, "center", read_only(given))
 
 
 __all__ = ["LinkShape"]

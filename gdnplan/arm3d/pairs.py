@@ -10,7 +10,11 @@ Every pair of links (each carrying collision shapes) falls in one of three kinds
   Adjacent links meet at their joint, and their shapes (mesh hulls especially) touch or overlap
   there at every configuration, so a check would report a collision that planning cannot
   remove. A locked joint on the way keeps a pair checked: with a UR5e's wrist joints locked the
-  gripper shares the forearm's body, yet it can fold into the upper arm;
+  gripper shares the forearm's body, yet it can fold into the upper arm. So a link that folds
+  back into its parent *away* from their joint is not seen either: the shipped UR5e's forearm
+  end enters its upper arm (up to 5 cm) for |elbow| > 2.9 rad, where its wrist links, which
+  are checked, already hit the upper arm (docs/decisions.md, the third certificate
+  adversary); for a robot of your own, limit such a joint where the fold begins;
 * the SRDF, when one is given, disables it (``<disable_collisions link1= link2= reason=/>``:
   MoveIt's "Adjacent", "Never", "Default", "Always"); the reason is kept. An SRDF pair must
   truly never come close: gdnplan does not look at it again.

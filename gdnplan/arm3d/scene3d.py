@@ -21,7 +21,7 @@ import coal
 import numpy as np
 
 from ..errors import InputError
-from ..limits import check_int, check_number, is_number, shown
+from ..limits import check_int, check_number, is_number, read_only, shown
 from ..robot import Robot, check_seed
 from .robot3d import Robot3D
 from .shapes import (
@@ -83,6 +83,12 @@ class Obstacle3D:
                 f"enclose its shape (its bounding sphere: centre {center.round(6).tolist()}, "
                 f"radius {radius:.6g} m); build obstacles with gdnplan.arm3d.obstacle"
             )
+        # copies (read-only arrays): the pair tables cache the broad phase from them, and a
+        # caller's pose object changed later must not move the obstacle under them
+        object.__setattr__(self, "pose", coal.Transform3s(self.pose))
+        object.__setattr__(self, "center", read_only(given))
+        if self.points is not None:
+            object.__setattr__(self, "points", read_only(self.points))
 
 
 def world_sphere(shape, pose: coal.Transform3s) -> tuple[np.ndarray, float]:
@@ -159,6 +165,17 @@ class Scene3D:
                 raise InputError(f"obstacles[{k}]: expected an Obstacle3D, got {type(o).__name__}")
         self.robot = robot
         self.obstacles = obstacles
+        object.__setattr__(self, "_frozen", True)
+
+    def __setattr__(self, name: str, value) -> None:
+        """Immutable once built: its checker, pair table and certificates are cached per scene
+        object, so a scene whose obstacles were replaced afterwards was certified against the
+        old ones (build a new Scene3D instead)."""
+        if getattr(self, "_frozen", False):
+            raise AttributeError(
+                f"Scene3D is immutable: build a new scene instead of setting {name!r}"
+            )
+        object.__setattr__(self, name, value)
 
     def __repr__(self) -> str:
         return f"Scene3D({self.robot.name}, {len(self.obstacles)} obstacles)"
