@@ -166,6 +166,16 @@ def check_count(value: object, limit: int, name: str, path: Path) -> None:
         )
 
 
+def check_depths(config: object, tensors: dict, path: Path) -> None:
+    """InputError unless a graph network's card asks for no more layers, edge-MLP layers and
+    readout layers than its tensors hold (checked before the network is built: a card asking
+    for a huge network would otherwise allocate it first)."""
+    limit = len(tensors)
+    check_count(config.layers, limit, "layers", path)
+    check_count(len(config.mlp) or 1, limit, "mlp", path)
+    check_count(len(config.readout) or 1, limit, "readout", path)
+
+
 def card_robot(card: dict) -> str | None:
     """The robot the card's weights were trained for (None: the card does not say)."""
     robot = card.get("robot")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-from ..checks import build_net, card_config, check_count
+from ..checks import build_net, card_config, check_depths
 from ..threads import check_threads
 from ..weights import read_weights
 from .config import GraphDistNetConfig
@@ -24,9 +24,7 @@ def load_graphdistnet_weights(
     path = Path(path)
     tensors, card = read_weights(path)
     config = card_config(path, card, "GraphDistNet", GraphDistNetConfig.from_dict)
-    for name, value in (("layers", config.layers), ("mlp", len(config.mlp) or 1)):
-        check_count(value, len(tensors), name, path)  # else a huge network before the check
-    check_count(len(config.readout) or 1, len(tensors), "readout", path)
+    check_depths(config, tensors, path)
     net = build_net(path, "GraphDistNet", lambda: GraphDistNet(config), tensors)
     model = GraphDistNetModel(net, card, threads=threads, fused=fused)
     model.source = str(path)

@@ -10,7 +10,7 @@ from pathlib import Path
 import torch
 
 from ...errors import InputError
-from ..checks import build_net, card_config, check_count
+from ..checks import build_net, card_config, check_depths
 from ..threads import check_threads
 from ..weights import read_weights
 from .config import GraphDistNet3DConfig
@@ -36,9 +36,7 @@ def load_graphdistnet3d(
     path = Path(path)
     tensors, card = read_graphdistnet3d(path)
     config = card_config(path, card, "GraphDistNet-3D", GraphDistNet3DConfig.from_dict)
-    for name, depth in (("layers", config.layers), ("mlp", len(config.mlp) or 1)):
-        check_count(depth, len(tensors), name, path)  # else a huge network before the check
-    check_count(len(config.readout) or 1, len(tensors), "readout", path)
+    check_depths(config, tensors, path)
     net = build_net(path, "GraphDistNet-3D", lambda: GraphDistNet3D(config), tensors)
     model = GraphDistNet3DModel(net, card, threads=threads, fused=fused)
     model.source = str(path)
