@@ -45,6 +45,8 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "ur5e.arms",
             "ur5e.ik",
             "ur5e.layout",  # fetch layouts: plane polygons and tcp targets, no distances
+            "arm3d.shape_numbers",  # coordinates, sizes and point sets of 3-D shapes
+            "arm3d.poses",  # positions and rotations of 3-D shapes
             "arm3d.shapes",
             "arm3d.pairs",
             "arm3d.link_shape",  # one link's collision shape, checked when made

@@ -1,7 +1,9 @@
 """3-D arms: robots from URDF through Pinocchio, posed convex obstacles, exact coal signed
 distance with self-collision and its gradient.
 
-* :mod:`gdnplan.arm3d.shapes`: validated coal shapes (primitives, hulls, meshes) and poses.
+* :mod:`gdnplan.arm3d.shapes`: validated coal shapes (primitives, hulls, meshes);
+  :mod:`gdnplan.arm3d.shape_numbers`: their coordinate, size and point checks;
+  :mod:`gdnplan.arm3d.poses`: poses (position, quaternion or rotation matrix).
 * :mod:`gdnplan.arm3d.robot3d`: :class:`Robot3D` from any URDF; :mod:`gdnplan.arm3d.builtin`:
   the UR5e, Panda and UR5; :mod:`gdnplan.arm3d.pairs`: self-collision pairs (SRDF).
 * :mod:`gdnplan.arm3d.scene3d`: obstacles and :class:`Scene3D`.

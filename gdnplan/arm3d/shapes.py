@@ -3,8 +3,8 @@
 Every shape reaches coal only after its numbers are checked, because coal's convex hull crashes
 the process (a segfault, no exception) on nearly flat point sets and huge coordinates:
 
-* coordinates and sizes are finite numbers with ``|x| ≤ MAX_COORDINATE`` (m);
-* primitive sizes (box sides, radii, lengths) are at least ``MIN_SIZE`` (m);
+* coordinates and sizes are finite numbers with ``|x| ≤ MAX_COORDINATE`` (m), primitive sizes
+  (box sides, radii, lengths) at least ``MIN_SIZE`` (m): :mod:`gdnplan.arm3d.shape_numbers`;
 * a point set's convex hull is computed first with scipy's Qhull (which raises instead of
   crashing) and must be thick: its thickness t = 2 V / A (hull volume V, surface area A; exact
   for a thin slab, 2 r / 3 for a ball of radius r) satisfies t ≥ MIN_SIZE and
@@ -15,9 +15,8 @@ A mesh is always used as its convex hull. A mesh with a vertex deeper than ``CON
 (a superset: distances to it are lower bounds of the mesh's), and a note is logged on the
 ``gdnplan.arm3d`` logger. Mesh files are read with coal's own loader (assimp: STL, OBJ, DAE, …).
 
-Poses are a position (3,) in metres and a rotation given as a quaternion (x, y, z, w), any
-nonzero length (normalised), or a 3×3 rotation matrix (orthonormal within ``ROTATION_TOLERANCE``,
-determinant +1).
+Poses (a position and a quaternion or rotation matrix) are checked in :mod:`gdnplan.arm3d.poses`;
+:func:`as_pose` and :func:`as_rotation` are re-exported here.
 """
 
 from __future__ import annotations
@@ -33,92 +32,22 @@ from scipy.spatial import ConvexHull, QhullError
 from ..errors import InputError, UnknownNameError
 from ..limits import is_number
 from ..urdf_robot.meshes import mesh_vertices
+from .poses import ORTHONORMAL_ROUNDING as ORTHONORMAL_ROUNDING
+from .poses import ROTATION_TOLERANCE as ROTATION_TOLERANCE
+from .poses import as_pose as as_pose
+from .poses import as_rotation as as_rotation
+from .shape_numbers import MAX_COORDINATE as MAX_COORDINATE
+from .shape_numbers import MAX_HULL_POINTS as MAX_HULL_POINTS
+from .shape_numbers import MIN_SIZE as MIN_SIZE
+from .shape_numbers import as_points as as_points
+from .shape_numbers import as_size as as_size
+from .shape_numbers import as_vector as as_vector
 
-MAX_COORDINATE = 1e3  # m: largest |coordinate| of any point, position or size
-MIN_SIZE = 1e-6  # m: smallest primitive size and hull thickness
 REL_THICKNESS = 1e-4  # hull thickness / diameter floor (coal's hull crashed near 1e-8)
-MAX_HULL_POINTS = 100_000  # points of one convex hull (mesh vertices)
 CONVEX_TOLERANCE = 1e-6  # a mesh vertex deeper than this · diameter inside its hull: non-convex
-ROTATION_TOLERANCE = 1e-6  # largest |RᵀR − I| entry of a rotation matrix
-ORTHONORMAL_ROUNDING = 4e-15  # |RᵀR − I| of a float64 rotation (an SVD's is ≤ 1.2e-15)
 DEPTH_BLOCK = 4_000_000  # (facet, point) entries per block of the convexity check (32 MB)
 
 log = logging.getLogger("gdnplan.arm3d")
-
-
-# -------------------------------------------------------------------- numbers
-def as_vector(value, n: int, name: str) -> np.ndarray:
-    """A finite float (n,) array of numbers bounded by MAX_COORDINATE, else InputError."""
-    items = np.asarray(value, dtype=object)
-    if items.shape != (n,) or not all(is_number(x) for x in items.ravel()):
-        raise InputError(f"{name}: expected {n} numbers, got {value!r}")
-    out = items.astype(float)
-    if not np.all(np.isfinite(out)):
-        raise InputError(f"{name}: contains NaN or infinite values ({value!r})")
-    if np.max(np.abs(out)) > MAX_COORDINATE:
-        raise InputError(f"{name}: values beyond {MAX_COORDINATE:g} m; use metres near the robot")
-    return out
-
-
-def as_size(value, name: str) -> float:
-    """A primitive size (m) in [MIN_SIZE, MAX_COORDINATE], else InputError."""
-    if not is_number(value) or not np.isfinite(value) or not MIN_SIZE <= value <= MAX_COORDINATE:
-        shown = value.item() if isinstance(value, np.generic) else value  # 0.0, not np.float64(0.0)
-        raise InputError(
-            f"{name}: expected a size in [{MIN_SIZE:g}, {MAX_COORDINATE:g}] m, got {shown!r}"
-        )
-    return float(value)
-
-
-def as_points(
-    points, name: str, min_points: int = 4, max_points: int = MAX_HULL_POINTS
-) -> np.ndarray:
-    """A finite, bounded float (k, 3) point array (min_points ≤ k ≤ max_points; the defaults:
-    a convex hull's), else InputError. Coordinates are real numbers: booleans, strings
-    (``"0.5"``), complex numbers and other objects are refused, not converted."""
-    pts = _real_array(points, name)
-    if pts.ndim != 2 or pts.shape[1] != 3 or not min_points <= len(pts) <= max_points:
-        raise InputError(
-            f"{name}: expected (k, 3) points with {min_points} ≤ k ≤ {max_points}, got {pts.shape}"
-        )
-    if not np.all(np.isfinite(pts)):
-        raise InputError(f"{name}: contains NaN or infinite coordinates")
-    if np.max(np.abs(pts)) > MAX_COORDINATE:
-        raise InputError(
-            f"{name}: coordinates beyond {MAX_COORDINATE:g} m; use metres near the robot"
-        )
-    return pts
-
-
-_NOT_REAL = {"b": "booleans", "U": "strings", "S": "bytes", "c": "complex numbers"}
-
-
-def _real_array(points, name: str) -> np.ndarray:
-    """``points`` as a float array when every entry is a real number (numpy kinds integer,
-    unsigned or float; a nested list element by element, where numpy would turn ``True`` into
-    1.0 silently), else InputError naming ``name``."""
-    if isinstance(points, (list, tuple)) or (
-        isinstance(points, np.ndarray) and points.dtype.kind == "O"
-    ):
-        try:
-            items = np.asarray(points, dtype=object)
-        except ValueError as e:  # a ragged nesting numpy cannot hold
-            raise InputError(f"{name}: expected points of shape (k, 3), got a ragged list") from e
-        if items.ndim != 2:  # empty, flat or ragged: the caller refuses the shape
-            return np.zeros(items.shape)
-        bad = [x for x in items.ravel() if not is_number(x)][:1]
-        if bad:
-            shown = bad[0].item() if isinstance(bad[0], np.generic) else bad[0]
-            raise InputError(f"{name}: expected real numbers as coordinates, got {shown!r}")
-        return items.astype(float)
-    try:
-        arr = np.asarray(points)
-    except (TypeError, ValueError, RuntimeError) as e:
-        raise InputError(f"{name}: expected points of shape (k, 3), got {type(points)}") from e
-    if arr.dtype.kind not in "iuf":
-        what = _NOT_REAL.get(arr.dtype.kind, f"an array of {arr.dtype}")
-        raise InputError(f"{name}: expected real numbers as coordinates, got {what}")
-    return arr.astype(float)
 
 
 # -------------------------------------------------------------------- shapes
@@ -288,50 +217,6 @@ def bvh_vertices(geometry) -> np.ndarray:
     if hasattr(geometry, "vertices"):
         return np.asarray(geometry.vertices(), dtype=float)
     return np.asarray(geometry.points(), dtype=float)
-
-
-# -------------------------------------------------------------------- poses
-def as_rotation(rotation, name: str = "rotation") -> np.ndarray:
-    """A 3×3 rotation matrix from a quaternion (x, y, z, w) or a matrix; None → identity."""
-    if rotation is None:
-        return np.eye(3)
-    items = np.asarray(rotation, dtype=object)
-    if items.shape == (4,):
-        quat = as_vector(rotation, 4, name)
-        norm = float(np.linalg.norm(quat))
-        if norm < 1e-9:
-            raise InputError(f"{name}: the quaternion (x, y, z, w) {rotation!r} has zero length")
-        x, y, z, w = quat / norm
-        return np.array(
-            [
-                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-            ]
-        )
-    if items.shape != (3, 3) or not all(is_number(x) for x in items.ravel()):
-        raise InputError(
-            f"{name}: expected a quaternion (x, y, z, w) or a 3×3 rotation matrix, got {rotation!r}"
-        )
-    rot = items.astype(float)
-    if not np.all(np.isfinite(rot)):
-        raise InputError(f"{name}: contains NaN or infinite values")
-    error = float(np.max(np.abs(rot.T @ rot - np.eye(3))))
-    if error > ROTATION_TOLERANCE or np.linalg.det(rot) < 0:
-        raise InputError(
-            f"{name}: not a rotation matrix (|RᵀR − I| = {error:.3g}, det = "
-            f"{np.linalg.det(rot):.3g}); give an orthonormal matrix with determinant +1"
-        )
-    if error <= ORTHONORMAL_ROUNDING:  # a rotation to rounding: kept, so that a matrix read
-        return rot  # back from a written problem file is the one written, bit for bit
-    u, _, vt = np.linalg.svd(rot)  # nearest exact rotation
-    return u @ vt
-
-
-def as_pose(position=(0.0, 0.0, 0.0), rotation=None, name: str = "pose") -> coal.Transform3s:
-    """A coal placement from a position (3,) in metres and a rotation (see :func:`as_rotation`)."""
-    p = as_vector(position, 3, f"{name}.position")
-    return coal.Transform3s(as_rotation(rotation, f"{name}.rotation"), p)
 
 
 def bounding_sphere(shape) -> tuple[np.ndarray, float]:
