@@ -63,6 +63,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
         # ur5e (the package) re-exports the fetch scene, which keeps coal-clear poses
         (
             "distance",
+            "ccd_motion",  # the planar lever arms and motion bound of the certificate
             "ccd",
             "ccd_curve",
             "ccd_contact",
