@@ -28,6 +28,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "flags",  # the one check of an on/off setting
             "files",
             "assets",
+            "convex_hulls",  # 2-D convex hulls: simplified, enclosing
             "geometry",
             "registry",
             "planar_chain",  # the plane rotations of a planar robot's chain
