@@ -13,7 +13,8 @@ e     planar7    5 random α-shapes: 20 uniform points in a unit square, α = 0.
                  (circumradius bound), largest piece, at most 15 vertices, scaled to 0.7 m
 ====  =========  ==================================================================
 
-No obstacle comes within ``robot.base_radius`` of the first joint.
+No obstacle comes within ``robot.base_radius`` of the first joint (the random polygons:
+:mod:`gdnplan.obstacle_draws`).
 """
 
 from __future__ import annotations
@@ -24,17 +25,13 @@ from functools import cached_property
 from pathlib import Path
 
 import numpy as np
-from shapely.geometry import Point, Polygon
 
 from .errors import InputError, ProblemFileError
-from .geometry import (
-    alpha_shape,
-    as_polygon,
-    convex_decomposition,
-    limit_vertices,
-    square,
-)
+from .geometry import as_polygon, convex_decomposition, square
 from .limits import check_int, read_only
+from .obstacle_draws import clear_of_base as clear_of_base
+from .obstacle_draws import place_clear, random_squares
+from .obstacle_draws import random_alpha_shape as random_alpha_shape
 from .registry import SCENES
 from .robot import Robot, factory_options, load_robot, robot_names, robot_options
 from .scene_checks import (
@@ -153,22 +150,6 @@ ENV_ROBOT = {"a": "planar2", "b": "planar2", "c": "planar7", "d": "planar7", "e"
 C_LAYOUT_SEED = 2022
 
 
-def clear_of_base(poly: np.ndarray, robot: Robot) -> bool:
-    """True when the polygon stays farther than ``robot.base_radius`` from joint 1."""
-    base = Point(*robot.chain.joint_origins[0])
-    return Polygon(poly).distance(base) > robot.base_radius
-
-
-def _place(draw: Callable[[np.random.Generator], np.ndarray], n: int, robot: Robot, rng) -> list:
-    """Draw n polygons, redrawing any that touch the base keep-out circle."""
-    out = []
-    while len(out) < n:
-        poly = draw(rng)
-        if clear_of_base(poly, robot):
-            out.append(poly)
-    return out
-
-
 @register_scene("a")
 def env_a(seed: int = 0) -> Scene:
     """planar2 and one fixed axis-aligned 0.3 m square (the seed is ignored)."""
@@ -186,45 +167,21 @@ def env_b(seed: int = 0) -> Scene:
         r, phi = 1.3 * np.sqrt(rng.uniform()), rng.uniform(0, 2 * np.pi)
         return square((r * np.cos(phi), r * np.sin(phi)), 0.3, rng.uniform(0, np.pi / 2))
 
-    return Scene(robot, tuple(_place(draw, 1, robot, rng)), name="b", seed=seed)
-
-
-def _squares(robot: Robot, seed: int, n: int = 20) -> list[np.ndarray]:
-    rng = np.random.default_rng(seed)
-    return _place(
-        lambda g: square(g.uniform(-2, 2, 2), 0.2, g.uniform(0, np.pi / 2)), n, robot, rng
-    )
+    return Scene(robot, tuple(place_clear(draw, 1, robot, rng)), name="b", seed=seed)
 
 
 @register_scene("c")
 def env_c(seed: int = 0) -> Scene:
     """planar7 and the fixed layout of 20 squares (env d drawn with seed 2022; seed ignored)."""
     robot = load_robot("planar7")
-    return Scene(robot, tuple(_squares(robot, C_LAYOUT_SEED)), name="c", seed=seed)
+    return Scene(robot, tuple(random_squares(robot, C_LAYOUT_SEED)), name="c", seed=seed)
 
 
 @register_scene("d")
 def env_d(seed: int = 0) -> Scene:
     """planar7 and 20 squares of 0.2 m, centres uniform in [-2, 2]², rotations uniform."""
     robot = load_robot("planar7")
-    return Scene(robot, tuple(_squares(robot, seed)), name="d", seed=seed)
-
-
-def random_alpha_shape(
-    rng: np.random.Generator, size: float = 0.7, alpha: float = 0.6, max_vertices: int = 15
-) -> np.ndarray:
-    """One α-shape obstacle centred at the origin (paper: 20 points, ≤ 15 connected, α = 0.6).
-
-    20 points uniform in the unit square, α-shape with circumradius bound ``alpha`` (unit
-    square units), largest piece, at most ``max_vertices`` vertices, scaled to ``size`` m.
-    """
-    while True:
-        points = rng.uniform(0, 1, (20, 2))
-        try:
-            poly = limit_vertices(alpha_shape(points, alpha), max_vertices)
-        except InputError:
-            continue
-        return (poly - poly.mean(0)) * size
+    return Scene(robot, tuple(random_squares(robot, seed)), name="d", seed=seed)
 
 
 @register_scene("e")
@@ -232,7 +189,7 @@ def env_e(seed: int = 0) -> Scene:
     """planar7 and 5 random α-shapes with centres uniform in [-1.8, 1.8]²."""
     robot = load_robot("planar7")
     rng = np.random.default_rng(seed)
-    shapes = _place(lambda g: random_alpha_shape(g) + g.uniform(-1.8, 1.8, 2), 5, robot, rng)
+    shapes = place_clear(lambda g: random_alpha_shape(g) + g.uniform(-1.8, 1.8, 2), 5, robot, rng)
     return Scene(robot, tuple(shapes), name="e", seed=seed)
 
 

@@ -38,6 +38,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "urdf_robot.*",
             "planar",
             "robot_file",
+            "obstacle_draws",  # random squares and α-shapes of the planar environments
             "scene_checks",  # a planar scene's robot, obstacles and problem-file tables
             "scene",
             "ur5e.kinematics",  # the UR5e/UR5 robot model: core robot modelling
