@@ -4,7 +4,8 @@ Every robot gdnplan plans for moves in a plane: all planning joints are revolute
 the plane normal ``n``, so its points move by plane rotations (:class:`PlanarChain`,
 :mod:`gdnplan.planar_chain`: batched positions and Jacobians in numpy); Pinocchio stays the
 reference (``Robot.node_positions_pinocchio``) and a test proves the two equal. Joint angles
-and seeds are checked by :mod:`gdnplan.robot_checks` (re-exported here).
+and seeds are checked by :mod:`gdnplan.robot_checks`, the plane and link polygons are
+:mod:`gdnplan.robot_plane`'s (both re-exported here).
 Robots are built from URDF files by :mod:`gdnplan.urdf_robot` (which checks that every
 planning joint turns about ``n``); this module looks robots up by name in the registry
 (:mod:`gdnplan.registry`), where :mod:`gdnplan.planar` and :mod:`gdnplan.ur5e` register the
@@ -25,55 +26,12 @@ from .limits import check_int, read_only
 from .planar_chain import PlanarChain, cross_z, rot2
 from .registry import ROBOTS, options_of
 from .robot_checks import as_batch, check_joint_range, check_seed, first_outside, make_rng
+from .robot_plane import LinkPolygon as LinkPolygon
+from .robot_plane import Plane as Plane
+from .robot_plane import apply_se3 as apply_se3
+from .robot_plane import joint_axis
 
 MAX_SAMPLES = 10**8  # configurations of one Robot.sample call
-
-
-@dataclass(frozen=True)
-class LinkPolygon:
-    """A convex polygon rigidly attached to one body of the chain.
-
-    Attributes:
-        name: e.g. ``"link3"`` or ``"forearm_link_0"``.
-        body: planning joints upstream (0 = fixed base, dof = last body).
-        frame: Pinocchio frame id the polygon is attached to.
-        vertices0: (m, 2) CCW vertices in plane coordinates at q = 0 (m).
-        vertices_frame: (m, 3) the same points in the frame's coordinates (Pinocchio reference).
-    """
-
-    name: str
-    body: int
-    frame: int
-    vertices0: np.ndarray
-    vertices_frame: np.ndarray
-
-    def __post_init__(self) -> None:  # read-only: the checkers and lever arms cache them
-        object.__setattr__(self, "vertices0", read_only(self.vertices0))
-        object.__setattr__(self, "vertices_frame", read_only(self.vertices_frame))
-
-
-@dataclass(frozen=True)
-class Plane:
-    """The planning plane: 2-D coordinates u = axes · (x − origin) of a world point x (3,)."""
-
-    origin: np.ndarray
-    axes: np.ndarray  # (2, 3), orthonormal rows
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "origin", read_only(self.origin))
-        object.__setattr__(self, "axes", read_only(self.axes))
-
-    @property
-    def normal(self) -> np.ndarray:
-        return np.cross(self.axes[0], self.axes[1])
-
-    def project(self, x: np.ndarray) -> np.ndarray:
-        """World points (..., 3) -> plane coordinates (..., 2)."""
-        return (x - self.origin) @ self.axes.T
-
-    def lift(self, u: np.ndarray) -> np.ndarray:
-        """Plane coordinates (..., 2) -> world points (..., 3) on the plane."""
-        return self.origin + u @ self.axes
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,7 +87,7 @@ class Robot:
         )
         signs = []
         for j in range(1, self.dof + 1):
-            axis = data.oMi[j].rotation @ _joint_axis(self.model, j)
+            axis = data.oMi[j].rotation @ joint_axis(self.model, j)
             signs.append(float(np.sign(axis @ self.plane.normal)))
         return PlanarChain(origins.reshape(self.dof, 2), np.array(signs))
 
@@ -264,22 +222,6 @@ class Robot:
                     out[b, n] = self.plane.axes @ lin
                     n += 1
         return out
-
-
-def apply_se3(placement: pin.SE3, points: np.ndarray) -> np.ndarray:
-    """Apply a rigid transform to points (k, 3)."""
-    return points @ placement.rotation.T + placement.translation
-
-
-def _joint_axis(model: pin.Model, j: int) -> np.ndarray:
-    """Unit axis of revolute joint j in its own frame."""
-    shortname = model.joints[j].shortname()
-    fixed = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1)}
-    if shortname in fixed:
-        return np.array(fixed[shortname], dtype=float)
-    if shortname == "JointModelRevoluteUnaligned":
-        return np.asarray(model.joints[j].extract().axis, dtype=float)
-    raise InputError(f"joint {model.names[j]!r}: only revolute joints can be planning joints")
 
 
 # -------------------------------------------------------------------- registry

@@ -33,6 +33,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "registry",
             "planar_chain",  # the plane rotations of a planar robot's chain
             "robot_checks",  # joint-angle batches and seeds of robot calls
+            "robot_plane",  # the planning plane, link polygons, joint axes
             "robot",
             "urdf_robot",
             "urdf_robot.*",

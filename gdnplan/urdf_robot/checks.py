@@ -9,7 +9,7 @@ import pinocchio as pin
 
 from ..errors import InputError, UnknownNameError
 from ..limits import is_number
-from ..robot import Plane, _joint_axis
+from ..robot_plane import Plane, joint_axis
 from .locking import CONTINUOUS, lock_mimics, set_locked
 from .spec import RobotSpec
 
@@ -116,7 +116,7 @@ def _check_axes(reduced: pin.Model, data: pin.Data, plane: Plane) -> None:
     the robot out of the plane (or, along the plane, move nothing in plane coordinates)."""
     n = plane.normal
     for j in range(1, reduced.njoints):
-        axis = data.oMi[j].rotation @ _joint_axis(reduced, j)
+        axis = data.oMi[j].rotation @ joint_axis(reduced, j)
         tilt = float(np.linalg.norm(np.cross(axis, n)))
         if tilt > AXIS_TOLERANCE:
             u, v = (np.round(a, 4).tolist() for a in plane.axes)
