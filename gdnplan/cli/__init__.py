@@ -10,13 +10,20 @@ errors 2 and 3 as well.
 The command lives in a package by concern: :mod:`~gdnplan.cli.app` (the app and :func:`run`),
 :mod:`~gdnplan.cli.common` (what the commands share), :mod:`~gdnplan.cli.plan` (``show``,
 ``plan``), :mod:`~gdnplan.cli.reproduce` (``evaluate``, ``reproduce``, ``field``),
+:mod:`~gdnplan.cli.reproduce_ablation` (``reproduce ablation``, ``reproduce faithful``),
 :mod:`~gdnplan.cli.fetch` and :mod:`~gdnplan.cli.train` (``generate``, ``train``). Importing the
 package registers every command.
 """
 
 from __future__ import annotations
 
-from . import fetch, plan, reproduce, train  # noqa: F401  (each registers its commands)
+from . import (  # noqa: F401  (each registers its commands)
+    fetch,
+    plan,
+    reproduce,
+    reproduce_ablation,
+    train,
+)
 from .app import EXIT_FAILED, EXIT_INPUT, EXIT_INTERNAL, EXIT_INTERRUPTED, app, main, one_line, run
 from .common import (
     check_limits,
