@@ -31,8 +31,9 @@ of the trained layout in a changed scene (Table I's "DiffCo w/o AL") is asked fo
 ``model.ignoring_obstacles()`` is a copy that evaluates any scene of the robot. DiffCo is
 not saved to files (it trains in seconds), so no stored model lacks its layout.
 
-Modules: the kernel and Fastron in :mod:`gdnplan.models.diffco_kernel`, the robot and layout
-checks in :mod:`gdnplan.models.diffco_scene`; this module re-exports their names.
+Modules: the kernel, its weighted sums (value and gradient) and Fastron in
+:mod:`gdnplan.models.diffco_kernel`, the robot and layout checks in
+:mod:`gdnplan.models.diffco_scene`; this module re-exports their names.
 """
 
 from __future__ import annotations
@@ -46,7 +47,8 @@ from ..errors import InputError
 from ..limits import check_int
 from ..robot import make_rng
 from ..scene import Scene, check_scene
-from .diffco_kernel import FKKernel, fastron
+from .diffco_kernel import CHUNK as CHUNK
+from .diffco_kernel import FKKernel, fastron, kernel_sum, kernel_sum_and_grad
 from .diffco_scene import (
     LAYOUT_TOL,
     dataset_difference,
@@ -59,7 +61,6 @@ from .diffco_scene import (
 from .fields import check_real
 from .settings import check_flag
 
-CHUNK = 1024  # query rows per kernel block
 FIT_MAX = 3000  # labelled configurations in the fitted surrogate
 MAX_POOL = 10_000  # labelled configurations of one perceptron fit: an n² kernel (800 MB)
 MAX_FASTRON_ITER = 10**8  # perceptron updates of one fit
@@ -255,12 +256,7 @@ class DiffCo:
 
     def _value(self, q: np.ndarray) -> np.ndarray:
         """(B,) the value at checked configurations q (B, dof)."""
-        feats = self.kernel.features(q)
-        sf = self.kernel.features(self.centers)
-        out = np.empty(len(q))
-        for s in range(0, len(q), CHUNK):
-            out[s : s + CHUNK] = self.kernel.matrix(feats[s : s + CHUNK], sf) @ self.weights
-        return out
+        return kernel_sum(self.kernel, self.centers, self.weights, q)
 
     def predict_dataset(self, ds, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
         """A dataset's (:class:`gdnplan.data.Dataset`) samples in one pass: (n,) values and,
@@ -288,20 +284,7 @@ class DiffCo:
 
     def _value_and_grad(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)) value and gradient at checked configurations q (B, dof)."""
-        n_nodes = self.kernel.robot.n_nodes
-        feats = self.kernel.features(q)  # (B, 2N) = x / √N
-        jac = self.kernel.robot.node_jacobians(q).reshape(len(q), 2 * n_nodes, q.shape[1])
-        sf = self.kernel.features(self.centers)
-        value, grad = np.empty(len(q)), np.empty(q.shape)
-        for s in range(0, len(q), CHUNK):
-            a = feats[s : s + CHUNK]
-            k, dk = self.kernel.from_features(a, sf)
-            value[s : s + CHUNK] = k @ self.weights
-            c = dk * self.weights  # (b, S): α_i ∂k/∂r²
-            # ∂r²/∂x = 2 (x/√N − x_i/√N) / √N  →  ∂/∂(scaled feature) times 1/√N
-            dfeat = 2 * (a * c.sum(1, keepdims=True) - c @ sf) / np.sqrt(n_nodes)
-            grad[s : s + CHUNK] = np.einsum("bf,bfj->bj", dfeat, jac[s : s + CHUNK])
-        return value, grad
+        return kernel_sum_and_grad(self.kernel, self.centers, self.weights, q)
 
 
 __all__ = [

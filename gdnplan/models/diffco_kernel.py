@@ -1,5 +1,5 @@
-"""DiffCo's forward-kinematics kernel and Fastron's perceptron updates (the model's mathematics,
-:mod:`gdnplan.models.diffco`).
+"""DiffCo's forward-kinematics kernel, its weighted sums with their gradient, and Fastron's
+perceptron updates (the model's mathematics, :mod:`gdnplan.models.diffco`).
 
 Control points are the robot's graph nodes x(q) = robot.node_positions(q) ∈ R^{N×2}; the
 kernel is the rational quadratic kernel on them,
@@ -20,6 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..robot import Robot
+
+CHUNK = 1024  # query rows per kernel block
 
 
 @dataclass(frozen=True)
@@ -92,4 +94,41 @@ def fastron(
     return alpha
 
 
-__all__ = ["FKKernel", "fastron"]
+def kernel_sum(
+    kernel: FKKernel, centers: np.ndarray, weights: np.ndarray, q: np.ndarray
+) -> np.ndarray:
+    """(B,) Σ_i w_i k(q, c_i) at checked configurations q (B, dof) (rad) over the kernel
+    centres c (C, dof) with weights w (C,), ``CHUNK`` query rows at a time."""
+    feats = kernel.features(q)
+    sf = kernel.features(centers)
+    out = np.empty(len(q))
+    for s in range(0, len(q), CHUNK):
+        out[s : s + CHUNK] = kernel.matrix(feats[s : s + CHUNK], sf) @ weights
+    return out
+
+
+def kernel_sum_and_grad(
+    kernel: FKKernel, centers: np.ndarray, weights: np.ndarray, q: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """((B,), (B, dof)) :func:`kernel_sum` and its exact gradient in q through the node
+    Jacobians J_n(q) (B, N, 2, dof):
+
+        ∂/∂q = Σ_i w_i ∂k/∂r² · (2/N) Σ_n (x_n(q) − x_n(c_i))ᵀ J_n(q).
+    """
+    n_nodes = kernel.robot.n_nodes
+    feats = kernel.features(q)  # (B, 2N) = x / √N
+    jac = kernel.robot.node_jacobians(q).reshape(len(q), 2 * n_nodes, q.shape[1])
+    sf = kernel.features(centers)
+    value, grad = np.empty(len(q)), np.empty(q.shape)
+    for s in range(0, len(q), CHUNK):
+        a = feats[s : s + CHUNK]
+        k, dk = kernel.from_features(a, sf)
+        value[s : s + CHUNK] = k @ weights
+        c = dk * weights  # (b, S): α_i ∂k/∂r²
+        # ∂r²/∂x = 2 (x/√N − x_i/√N) / √N  →  ∂/∂(scaled feature) times 1/√N
+        dfeat = 2 * (a * c.sum(1, keepdims=True) - c @ sf) / np.sqrt(n_nodes)
+        grad[s : s + CHUNK] = np.einsum("bf,bfj->bj", dfeat, jac[s : s + CHUNK])
+    return value, grad
+
+
+__all__ = ["CHUNK", "FKKernel", "fastron", "kernel_sum", "kernel_sum_and_grad"]
