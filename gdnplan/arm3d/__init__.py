@@ -4,7 +4,8 @@ distance with self-collision and its gradient.
 * :mod:`gdnplan.arm3d.shapes`: validated coal shapes (primitives, hulls, meshes);
   :mod:`gdnplan.arm3d.shape_numbers`: their coordinate, size and point checks;
   :mod:`gdnplan.arm3d.poses`: poses (position, quaternion or rotation matrix).
-* :mod:`gdnplan.arm3d.robot3d`: :class:`Robot3D` from any URDF; :mod:`gdnplan.arm3d.builtin`:
+* :mod:`gdnplan.arm3d.robot3d`: :class:`Robot3D` from any URDF (its link shapes:
+  :mod:`gdnplan.arm3d.link_shape`); :mod:`gdnplan.arm3d.builtin`:
   the UR5e, Panda and UR5; :mod:`gdnplan.arm3d.pairs`: self-collision pairs (SRDF).
 * :mod:`gdnplan.arm3d.scene3d`: obstacles and :class:`Scene3D`.
 * :mod:`gdnplan.arm3d.distance3d`: signed distance and its minimising pairs (broad phase);

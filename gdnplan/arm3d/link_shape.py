@@ -1,5 +1,7 @@
 """One collision shape of a 3-D robot link (:class:`LinkShape`), checked when made: the
-continuous certificate's lever arms and the broad phase trust its bounding sphere."""
+continuous certificate's lever arms and the broad phase trust its bounding sphere; made from a
+URDF's Pinocchio geometry object by :func:`link_shape_from_geometry` (URDF primitives stay coal
+primitives, meshes become their convex hulls)."""
 
 from __future__ import annotations
 
@@ -7,10 +9,22 @@ from dataclasses import dataclass
 
 import coal
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InputError
 from ..limits import check_int, is_number, read_only
-from .shapes import as_pose, as_vector, bounding_sphere, check_shape
+from .shapes import (
+    as_pose,
+    as_vector,
+    bounding_sphere,
+    box,
+    bvh_vertices,
+    capsule,
+    check_shape,
+    cylinder,
+    mesh_hull,
+    sphere,
+)
 
 
 @dataclass(frozen=True)
@@ -65,4 +79,31 @@ class LinkShape:
         object.__setattr__(self, "center", read_only(given))
 
 
-__all__ = ["LinkShape"]
+def link_shape_from_geometry(model: pin.Model, obj: pin.GeometryObject) -> LinkShape:
+    """The validated coal shape of one geometry object (a mesh becomes its convex hull)."""
+    g, where = obj.geometry, f"geometry {obj.name!r}"
+    if isinstance(g, coal.Box):
+        shape = box(2 * np.asarray(g.halfSide), where)
+    elif isinstance(g, coal.Sphere):
+        shape = sphere(g.radius, where)
+    elif isinstance(g, coal.Capsule):
+        shape = capsule(g.radius, 2 * g.halfLength, where)
+    elif isinstance(g, coal.Cylinder):
+        shape = cylinder(g.radius, 2 * g.halfLength, where)
+    elif hasattr(g, "vertices") or hasattr(g, "points"):
+        shape = mesh_hull(bvh_vertices(g), where)
+    else:
+        raise InputError(f"{where}: unsupported collision shape {type(g).__name__}")
+    center, radius = bounding_sphere(shape)
+    return LinkShape(
+        name=obj.name,
+        link=model.frames[obj.parentFrame].name,
+        body=int(obj.parentJoint),
+        shape=shape,
+        placement=obj.placement.homogeneous.copy(),
+        center=center,
+        radius=radius,
+    )
+
+
+__all__ = ["LinkShape", "link_shape_from_geometry"]

@@ -21,7 +21,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-import coal
 import numpy as np
 import pinocchio as pin
 
@@ -34,9 +33,9 @@ from ..urdf_robot.joint_limits import check_joint_limits
 from ..urdf_robot.load import check_mimic, urdf_path
 from ..urdf_robot.locking import lock_mimics, set_locked
 from ..urdf_robot.spec import check_folders, check_locked, check_names
-from .link_shape import LinkShape
+from .link_shape import LinkShape as LinkShape
+from .link_shape import link_shape_from_geometry
 from .pairs import contact_only_mask, self_collision_pairs
-from .shapes import bounding_sphere, box, bvh_vertices, capsule, cylinder, mesh_hull, sphere
 
 
 class Robot3D:
@@ -235,7 +234,7 @@ def robot3d_from_urdf(
     lock_mimics(model, q_ref, path, set(locked or {}))
     lock_ids = [j for j in range(1, model.njoints) if model.names[j] not in planning]
     reduced, reduced_geom = pin.buildReducedModel(model, geom, lock_ids, q_ref)
-    shapes = [_link_shape(reduced, obj) for obj in reduced_geom.geometryObjects]
+    shapes = [link_shape_from_geometry(reduced, obj) for obj in reduced_geom.geometryObjects]
     if not shapes:
         raise InputError(
             f"urdf: {path.name} has no collision geometry (<visual> elements are not read); "
@@ -279,30 +278,3 @@ def _locked_configuration(
             raise UnknownNameError(f"locked: {jname!r} is not a non-planning joint of {source}")
         set_locked(model, q, jname, value)
     return q
-
-
-def _link_shape(model: pin.Model, obj: pin.GeometryObject) -> LinkShape:
-    """The validated coal shape of one geometry object (a mesh becomes its convex hull)."""
-    g, where = obj.geometry, f"geometry {obj.name!r}"
-    if isinstance(g, coal.Box):
-        shape = box(2 * np.asarray(g.halfSide), where)
-    elif isinstance(g, coal.Sphere):
-        shape = sphere(g.radius, where)
-    elif isinstance(g, coal.Capsule):
-        shape = capsule(g.radius, 2 * g.halfLength, where)
-    elif isinstance(g, coal.Cylinder):
-        shape = cylinder(g.radius, 2 * g.halfLength, where)
-    elif hasattr(g, "vertices") or hasattr(g, "points"):
-        shape = mesh_hull(bvh_vertices(g), where)
-    else:
-        raise InputError(f"{where}: unsupported collision shape {type(g).__name__}")
-    center, radius = bounding_sphere(shape)
-    return LinkShape(
-        name=obj.name,
-        link=model.frames[obj.parentFrame].name,
-        body=int(obj.parentJoint),
-        shape=shape,
-        placement=obj.placement.homogeneous.copy(),
-        center=center,
-        radius=radius,
-    )
