@@ -26,6 +26,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "errors",
             "limits",
             "flags",  # the one check of an on/off setting
+            "input_files",  # input files read whole, bounded
             "files",
             "assets",
             "convex_hulls",  # 2-D convex hulls: simplified, enclosing
