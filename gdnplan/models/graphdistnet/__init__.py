@@ -69,9 +69,10 @@ Modules: :mod:`.config` (options), :mod:`.geometry` (candidates, ring distances)
 :mod:`.layers` (MLPs, readout softmax, ring messages), :mod:`.network` (the module and its
 padded forward), :mod:`.lean` (the lean inference path), :mod:`.model` (the DistanceModel
 wrapper), :mod:`.load` (weights files: :func:`load_graphdistnet_weights`), :mod:`.fused` (the
-fused numba kernels of the lean path), :mod:`.fused_net` with :mod:`.fused_net_kernels` and
-:mod:`.fused_net_backward` (the whole network, forward and backward to the node positions,
-as one compiled pass: the default for the soft-kNN networks it serves).
+fused numba kernels of the lean path), :mod:`.fused_net` with :mod:`.fused_net_kernels`,
+:mod:`.fused_net_readout` and :mod:`.fused_net_backward` (the whole network, forward and
+backward to the node positions, as one compiled pass: the default for the soft-kNN networks it
+serves).
 """
 
 from .config import GraphDistNetConfig

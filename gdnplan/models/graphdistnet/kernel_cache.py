@@ -2,12 +2,12 @@
 
 numba (``cache=True``) keys a cached function on its own source file's modification time and
 size only. The kernels call one another across modules (:mod:`.fused_net_kernels` inlines
-:mod:`.fused_net_distances`, :mod:`.fused`, :mod:`.gemm`; the 3-D kernels call the planar
-ones), so a change to a callee's file leaves its callers' cached machine code in place, with
-the old callee compiled in: a checkout that pulls a change to one kernel file would run stale
-code without an error. :func:`purge_stale` compares one digest of every kernel source with the
-digest stored beside the cache and, when they differ, deletes the cached kernels of all of
-them (numba compiles them again on first use, ≈ 1 min).
+:mod:`.fused_net_readout`, :mod:`.fused_net_distances`, :mod:`.fused`, :mod:`.gemm`; the 3-D
+kernels call the planar ones), so a change to a callee's file leaves its callers' cached machine
+code in place, with the old callee compiled in: a checkout that pulls a change to one kernel
+file would run stale code without an error. :func:`purge_stale` compares one digest of every
+kernel source with the digest stored beside the cache and, when they differ, deletes the cached
+kernels of all of them (numba compiles them again on first use, ≈ 1 min).
 """
 
 from __future__ import annotations
