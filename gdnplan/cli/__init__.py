@@ -8,11 +8,11 @@ traceback``); 130 interrupted (Ctrl-C). ``gdnplan --debug <command> …`` prints
 errors 2 and 3 as well.
 
 The command lives in a package by concern: :mod:`~gdnplan.cli.app` (the app and :func:`run`),
-:mod:`~gdnplan.cli.common` (what the commands share), :mod:`~gdnplan.cli.plan` (``show``,
-``plan``), :mod:`~gdnplan.cli.reproduce` (``evaluate``, ``reproduce``, ``field``),
-:mod:`~gdnplan.cli.reproduce_ablation` (``reproduce ablation``, ``reproduce faithful``),
-:mod:`~gdnplan.cli.fetch` and :mod:`~gdnplan.cli.train` (``generate``, ``train``). Importing the
-package registers every command.
+:mod:`~gdnplan.cli.common` (what the commands share), :mod:`~gdnplan.cli.plan` (``show``, ``plan``;
+their reports: :mod:`~gdnplan.cli.plan_report`), :mod:`~gdnplan.cli.reproduce` (``evaluate``,
+``reproduce``, ``field``), :mod:`~gdnplan.cli.reproduce_ablation` (``reproduce ablation``,
+``reproduce faithful``), :mod:`~gdnplan.cli.fetch` and :mod:`~gdnplan.cli.train` (``generate``,
+``train``). Importing the package registers every command.
 """
 
 from __future__ import annotations
