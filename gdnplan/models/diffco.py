@@ -252,11 +252,7 @@ class DiffCo:
         """(B,) −s(q) (or the fitted surrogate) at q (B, dof) (rad) in ``scene``, a scene of
         the training robot and obstacles (:meth:`check_scene`)."""
         self.check_scene(scene)
-        return self._value(scene.robot.check_q(q))
-
-    def _value(self, q: np.ndarray) -> np.ndarray:
-        """(B,) the value at checked configurations q (B, dof)."""
-        return kernel_sum(self.kernel, self.centers, self.weights, q)
+        return kernel_sum(self.kernel, self.centers, self.weights, scene.robot.check_q(q))
 
     def predict_dataset(self, ds, grad: bool) -> tuple[np.ndarray, np.ndarray | None]:
         """A dataset's (:class:`gdnplan.data.Dataset`) samples in one pass: (n,) values and,
@@ -272,18 +268,15 @@ class DiffCo:
             bad = dataset_difference(self.obstacles, ds.obstacles, ds.sizes)
             if bad is not None:
                 raise stale_layout_error(f"dataset sample {bad[0]}", bad[1])
-        q = self.kernel.robot.check_q(ds.q)
-        return self._value_and_grad(q) if grad else (self._value(q), None)
+        fit = (self.kernel, self.centers, self.weights, self.kernel.robot.check_q(ds.q))
+        return kernel_sum_and_grad(*fit) if grad else (kernel_sum(*fit), None)
 
     def distance_and_grad(self, scene: Scene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((B,), (B, dof)) the value and its exact gradient through the node Jacobians at q
         (B, dof) (rad) in ``scene``, a scene of the training robot and obstacles
         (:meth:`check_scene`)."""
         self.check_scene(scene)
-        return self._value_and_grad(scene.robot.check_q(q))
-
-    def _value_and_grad(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """((B,), (B, dof)) value and gradient at checked configurations q (B, dof)."""
+        q = scene.robot.check_q(q)
         return kernel_sum_and_grad(self.kernel, self.centers, self.weights, q)
 
 
