@@ -120,3 +120,27 @@ def test_a_compiled_step_network_is_kept():
     compiled = torch.compile(net, dynamic=True)
     assert GraphDistNetLearner(net, None, None, None, step_net=compiled).step_net is compiled
     assert GraphDistNetLearner(net, None, None, None).step_net is net
+
+
+@pytest.mark.parametrize(
+    ("scale", "message"), [(float("nan"), "NaN or infinite"), (1e4, "overflow")]
+)
+def test_library_init_refuses_weights_that_cannot_train(tiny_data, scale, message):
+    """Audit: ``TrainConfig(init=…)`` from Python loaded NaN weights unchecked (only the CLI
+    checked them), and weights within the magnitude bound whose network overflows trained
+    an epoch and were reported as a run that "diverged at epoch 0"."""
+    from safetensors.torch import load_file
+
+    from gdnplan.models.weights import read_card, write_weights
+
+    network = GraphDistNetConfig.smooth().with_(layers=1)
+    start = tiny_data / "start.safetensors"
+    train("a", TrainConfig(network, fit=FitConfig(epochs=1)), data_root=tiny_data, out=start,
+          run_dir=tiny_data / "r1")  # fmt: skip
+    tensors = {k: v * scale for k, v in load_file(str(start)).items()}
+    bad = write_weights(tiny_data / "bad.safetensors", tensors, read_card(start))
+    tune = TrainConfig(network, fit=FitConfig(epochs=1), init=bad)
+    with pytest.raises(InputError, match=message) as info:
+        train("a", tune, data_root=tiny_data, out=tiny_data / "t.safetensors",
+              run_dir=tiny_data / "r2")  # fmt: skip
+    assert "bad.safetensors" in str(info.value)

@@ -232,17 +232,7 @@ def _graphdistnet_run(preset, set_, init, schedule, n_train, extra, compile):
 
 def check_init(path) -> None:
     """InputError unless the weights ``path`` of ``--init`` are planar GraphDistNet weights
-    whose tensors load: finite, within :data:`gdnplan.models.outputs.MAX_WEIGHT` (3-D weights
-    were refused as "--set: unknown GraphDistNet options ['length', 'rim']", NaN or huge ones
-    as a training that "diverged at epoch 0")."""
-    from ..models.checks import load_tensors
-    from ..models.outputs import check_magnitudes
-    from ..models.weights import read_card
+    whose tensors load (:func:`gdnplan.train.graphdistnet.init_tensors`), before the data."""
+    from ..train.graphdistnet import init_tensors
 
-    model = read_card(path, "--init").get("model")
-    if model != "graphdistnet":
-        raise InputError(
-            f"--init: {path} holds {model!r} weights; gdnplan train fine-tunes planar "
-            "GraphDistNet weights (a card of model 'graphdistnet', e.g. the shipped 'd')"
-        )
-    check_magnitudes(path, load_tensors(path, "--init"))
+    init_tensors(Path(path))

@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import torch
-from safetensors.torch import load_file
 
 from ..data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from ..errors import InputError
@@ -51,6 +50,41 @@ def check_env(ds: Dataset, env: str, where: Path | str) -> Dataset:
     return ds
 
 
+def init_tensors(path: Path) -> dict[str, torch.Tensor]:
+    """The tensors of the ``--init`` weights ``path``: InputError unless its card is planar
+    GraphDistNet's and its tensors are finite, within ±:data:`~gdnplan.models.outputs.MAX_WEIGHT`
+    (3-D weights read as unknown options, NaN or huge ones as a training that diverged)."""
+    from ..models.checks import load_tensors
+    from ..models.outputs import check_magnitudes
+
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"--init: {path} does not exist")
+    model = read_card(path, "--init").get("model")
+    if model != "graphdistnet":
+        raise InputError(
+            f"--init: {path} holds {model!r} weights; training fine-tunes planar GraphDistNet "
+            "weights (a card of model 'graphdistnet', e.g. the shipped 'd')"
+        )
+    tensors = load_tensors(path, "--init")
+    check_magnitudes(path, tensors)
+    return tensors
+
+
+def check_init_outputs(net: GraphDistNet, t: Tensors, path: Path, device: str) -> None:
+    """InputError when the ``--init`` network's d̂ is not finite on the first training samples
+    (finite but overflowing weights: the training would stop at once as "diverged")."""
+    net.eval()
+    robot, obstacles = t.batch(torch.arange(min(64, len(t))), device)
+    with torch.inference_mode():
+        d = net(robot, obstacles, torch.Generator(device=device).manual_seed(0))
+    if not bool(torch.isfinite(d).all()):
+        raise InputError(
+            f"--init: the network of {path} gives NaN or infinite distances on the training "
+            "data before any step (its weights overflow); start from other weights"
+        )
+
+
 def _load_init(net: GraphDistNet, path: Path) -> None:
     """Load the weights at ``path`` into ``net``; InputError if missing or of another shape.
 
@@ -59,9 +93,7 @@ def _load_init(net: GraphDistNet, path: Path) -> None:
     plain readout start a ``correction_band`` network with the head's m input at weight 0 (and
     τ_m at ``tau_min``): its MLP is then the loaded estimate, used in and near overlap.
     """
-    if not path.exists():
-        raise InputError(f"--init: {path} does not exist")
-    state = load_file(str(path))
+    state = init_tensors(path)
     if net.config.node_distance and "distance_in" not in state:
         state["distance_in"] = torch.zeros_like(net.distance_in)
     first = state.get("head.0.weight")
@@ -178,6 +210,7 @@ def train(
     net = GraphDistNet(network).to(device)
     if c.init is not None:
         _load_init(net, Path(c.init))
+        check_init_outputs(net, train_t, Path(c.init), device)
     step_net = torch.compile(net, dynamic=True) if c.compile else net
     run_dir.mkdir(parents=True, exist_ok=True)  # after the checks of the data
     ckpt = run_dir / "checkpoint.safetensors"
