@@ -29,6 +29,8 @@ def test_generate_is_resumable_and_load_concatenates(tmp_path, monkeypatch):
     np.testing.assert_array_equal(ds.scene_seed, np.arange(10) + 10**8)
     np.testing.assert_allclose(ds.d, np.concatenate([s.d for s in shards]))
     assert len(data.load(out, n=5)) == 5
+    with pytest.warns(UserWarning, match="holds 10 samples, fewer than the 11 asked for"):
+        assert len(data.load(out, n=11)) == 10  # audit: a larger --n-train was silent
 
 
 def test_bad_inputs_raise(tmp_path):

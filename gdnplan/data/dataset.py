@@ -21,6 +21,7 @@ for ``ur5e`` ``nodes`` is zero-padded to the largest robot graph.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -121,8 +122,9 @@ def variant_robot(gripper: int, stick_length: float = 0.0, stick_width: float = 
 
 
 def load(path: Path | str, n: int | None = None) -> Dataset:
-    """Load a split (a directory of shards, or one ``.npz``), at most its first n samples;
-    every shard checked as it is read (:mod:`.shard_read`), InputError naming the file."""
+    """Load a split (a directory of shards, or one ``.npz``), at most its first n samples
+    (a UserWarning when it holds fewer: all of them are used); every shard checked as it is
+    read (:mod:`.shard_read`), InputError naming the file."""
     path = Path(path)
     files = sorted(path.glob("shard_*.npz")) if path.is_dir() else [path] * path.exists()
     files = [f for f in files if not f.name.endswith(".tmp.npz")]
@@ -138,6 +140,12 @@ def load(path: Path | str, n: int | None = None) -> Dataset:
         total += len(parts[-1]["q"])
         if n is not None and total >= n:
             break
+    if n is not None and total < n:
+        warnings.warn(
+            f"data: {path} holds {total} samples, fewer than the {n} asked for; using all "
+            f"{total} (generate more with `gdnplan generate`)",
+            stacklevel=2,
+        )
     return _join(parts, n)
 
 
