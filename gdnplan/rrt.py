@@ -210,11 +210,15 @@ def seed_path(
     time_limit: float = 10.0,
     step: float = 2.0,
     max_iterations: int = 5000,
+    lower: np.ndarray | None = None,
+    upper: np.ndarray | None = None,
 ) -> tuple[np.ndarray | None, RRTResult]:
-    """RRT-Connect (at most ``max_iterations`` extensions) + shortcut + resample:
-    (n_waypoints, dof) seed, or None on failure."""
+    """RRT-Connect (at most ``max_iterations`` extensions, sampling within the joint limits
+    [``lower``, ``upper``] (dof,) rad, the robot's when None) + shortcut + resample:
+    (n_waypoints, dof) seed, or None on failure. Shortcuts and resampling stay within the
+    limits (a box holds the straight segment between two of its points)."""
     res = rrt_connect(scene, start, goal, clearance, step=step, seed=seed, time_limit=time_limit,
-                      max_iterations=max_iterations)  # fmt: skip
+                      max_iterations=max_iterations, lower=lower, upper=upper)  # fmt: skip
     if not res.success:
         return None, res
     path = shortcut(scene, res.path, clearance, seed=seed)

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
 import gdnplan as gp
@@ -337,3 +337,36 @@ def test_an_rrt_seed_does_not_depend_on_the_clock(name, monkeypatch):
     assert len(draws) == seeds.SCREENED
     assert normal is not None and slow is not None
     np.testing.assert_array_equal(slow, normal)
+
+
+@settings(max_examples=8, deadline=None)
+@given(stream=st.integers(0, 1000), kind=st.sampled_from(["rrt", "via"]))
+@example(stream=0, kind="rrt")
+def test_a_seed_stays_within_the_problem_joint_limits(stream, kind):
+    """Problem(lower=…, upper=…) narrows the robot's joint limits: every seed kind samples
+    within them. The rrt kind sampled the robot's own limits, so its seed left the problem's box
+    (Ipopt then clipped it into collision), and on a goal enclosed by the narrowed limits
+    RRT-Connect "found" a path around the obstacle outside them."""
+    from gdnplan.trajopt.seeds import SEED_KINDS
+
+    base = Problem.from_toml("planar2_square")
+    lower, upper = np.array([1.3, -2.9]), np.array([2.2, -0.5])
+    problem = replace_limits(base, lower, upper)
+    request = SeedRequest(problem, problem.goal, problem.margin, stream, 0, 5.0, 2.0)
+    path = SEED_KINDS[kind](request)
+    if path is not None:
+        assert np.all((path >= lower) & (path <= upper))
+    enclosed = Problem(  # joint 0 held within 0.02 rad of 1.0: the forearm cannot get round
+        base.scene, [1.0, -2.9], [1.0, 0.5], lower=[0.98, -3.14], upper=[1.02, 3.14]
+    )
+    request = SeedRequest(enclosed, enclosed.goal, enclosed.margin, stream, 0, 0.5, 2.0)
+    path = SEED_KINDS[kind](request)
+    assert path is None or np.all((path >= enclosed.lower) & (path <= enclosed.upper))
+
+
+def replace_limits(problem: Problem, lower, upper) -> Problem:
+    """``problem`` with narrowed joint limits [lower, upper] (rad)."""
+    return Problem(
+        problem.scene, problem.start, problem.goal, waypoints=problem.waypoints,
+        margin=problem.margin, lower=lower, upper=upper,
+    )  # fmt: skip

@@ -110,6 +110,8 @@ def rrt_seed(request: SeedRequest) -> np.ndarray | None:
             time_limit=left,
             step=request.rrt_step,
             max_iterations=cap,
+            lower=p.lower,  # the problem's limits, not the robot's (a narrowed box)
+            upper=p.upper,
         )
         if j == 0:
             cap = min(cap, max(SCREEN_MIN_ITER, SCREEN_ITER_FACTOR * res.iterations))
