@@ -12,8 +12,10 @@ from hypothesis import strategies as st
 import gdnplan as gp
 from gdnplan.ccd import certify_path
 from gdnplan.distance import signed_distance
+from gdnplan.limits import MAX_INTERPOLATED
 from gdnplan.models import CoalModel
-from gdnplan.trajopt import PlanConfig, Problem, RefineConfig, SeedConfig, plan
+from gdnplan.trajopt import IpoptConfig, PlanConfig, Problem, RefineConfig, SeedConfig, plan
+from gdnplan.trajopt.config import more_check_points
 from gdnplan.trajopt.polish import (
     POLISH_ITER_FACTOR,
     POLISH_MIN_ITER,
@@ -114,3 +116,35 @@ def test_every_polish_solve_gets_the_cap(square, monkeypatch):
     polish(p, CoalModel(), p.goal, PlanConfig(), run)
     assert seen and all(m == polish_iterations(run, PlanConfig().optimizer.max_iter) for m in seen)
     assert seen[0] == max(POLISH_MIN_ITER, POLISH_ITER_FACTOR * 20)
+
+
+@pytest.mark.parametrize("stage", ["polish", "repair", "replaced attempt"])
+def test_the_planner_adds_no_check_points_past_the_limit(square, stage):
+    """IpoptConfig(interpolated=MAX_INTERPOLATED) is allowed; the check points the planner
+    adds itself (a replaced attempt: one per failure, the polish and the repair: REPAIR_EXTRA
+    and POLISH_STAGES' extras) stop at that limit. They re-made the config with
+    interpolated = 51 and plan raised "interpolated: expected an integer in [0, 50], got 51",
+    a setting the caller never gave."""
+    top = IpoptConfig(interpolated=MAX_INTERPOLATED)
+    assert more_check_points(top, 2).interpolated == MAX_INTERPOLATED
+    assert more_check_points(IpoptConfig(interpolated=3), 2).interpolated == 5
+    if stage == "polish":
+        p = Problem(scene=square, start=START, goal=GOAL, waypoints=8)
+        cfg = PlanConfig(SeedConfig(initial="rrt", count=1), RefineConfig(repair=False), top)
+        result = plan(p, collision="coal", solver=cfg)
+        assert result.success and certify_path(square, result.q, p.certified_clearance).ok
+    elif stage == "repair":
+        _, base = unpolished(square)
+        margin = base.sampled_min_distance + 0.0005
+        p = Problem(scene=square, start=START, goal=GOAL, waypoints=12, margin=margin)
+        before = certify_path(square, base.q, p.certified_clearance)
+        run = _Run(q=base.q, status="Solved_To_Acceptable_Level", verified=before)
+        repair(p, CoalModel(), p.goal, PlanConfig(optimizer=top), run)
+        assert run.verified is None or run.verified.ok is not None
+    else:  # joint 0 held near 1.0: the forearm cannot get round, every attempt fails
+        p = Problem(square, [1.0, -2.9], [1.0, 0.5], waypoints=5, lower=[0.98, -3.14],
+                    upper=[1.02, 3.14])  # fmt: skip
+        seed = SeedConfig(initial="straight", count=1, starts=2)
+        cfg = PlanConfig(seed, RefineConfig(rounds=0, polish=False, repair=False), top)
+        result = plan(p, collision="coal", solver=cfg)
+        assert not result.success and result.attempts == 2

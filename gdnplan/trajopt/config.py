@@ -102,7 +102,8 @@ class IpoptConfig:
 
     Attributes:
         interpolated: M check points strictly between consecutive waypoints (before
-            refining); each replaced attempt adds one (see ``SeedConfig.starts``); the
+            refining); each replaced attempt adds one (see ``SeedConfig.starts``; the
+            planner's own additions stop at ``limits.MAX_INTERPOLATED``); the
             certificate and refine rounds catch what sparse check points miss
             (docs/decisions.md#ipopt-check-points-per-segment).
         per_link: one distance row per link polygon (capped at ``link_cap``) instead of one;
@@ -199,6 +200,14 @@ class PlanConfig:
         return self.optimizer.interpolated
 
 
+def more_check_points(optimizer: IpoptConfig, extra: int) -> IpoptConfig:
+    """``optimizer`` with ``extra`` ≥ 0 more check points per segment, at most
+    ``MAX_INTERPOLATED``: the check points the planner adds itself (a replaced attempt, the
+    polish and the repair solves) stop at the limit of the caller's setting (making the config
+    anew with ``interpolated`` past it raised an InputError naming a setting never given)."""
+    return replace(optimizer, interpolated=min(optimizer.interpolated + extra, MAX_INTERPOLATED))
+
+
 OPTIMIZERS: dict[str, type] = {"ipopt": IpoptConfig, "adam": AdamConfig}
 
 
@@ -239,5 +248,6 @@ __all__ = [
     "RefineConfig",
     "SeedConfig",
     "config_keys",
+    "more_check_points",
     "with_optimizer",
 ]

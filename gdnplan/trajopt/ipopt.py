@@ -23,7 +23,7 @@ from .check_points import (
     model_overestimate,
     straight_line,
 )
-from .config import PlanConfig
+from .config import PlanConfig, more_check_points
 from .problem import Problem
 from .refine import underestimated_segments, with_exact_rows
 from .result import _Run, path_cost, path_violation
@@ -86,8 +86,9 @@ def _plan_ipopt(
     within one, a failed seed draws the next until the budget ends), or the clock passes
     ``deadline``. An attempt that ends uncertified suggests check points too sparse for the
     problem, so after f such attempts a seed starts with ``interpolated + min(f, starts − 1)``
-    check points per segment (on one (d) problem, #14, all three attempts with 2 check points
-    ended uncertified, the path slipping through an obstacle between them; with 3 it succeeded).
+    check points per segment, at most ``MAX_INTERPOLATED`` (on one (d) problem, #14, all three
+    attempts with 2 check points ended uncertified, the path slipping through an obstacle
+    between them; with 3 it succeeded).
     """
     sc = cfg.seed
     line = straight_line(problem.start, goal, problem.waypoints)
@@ -97,7 +98,7 @@ def _plan_ipopt(
         return _Run(q=line, status=status, reason=status, seed=SeedInfo("straight", 0, seed))
     clearance = _seed_clearance(problem, goal, sc.rrt_clearance)
     run, best, failures = _Run(q=line), _Best(), 0
-    first, wanted = cfg.optimizer.interpolated, sc.seed_count
+    wanted = sc.seed_count
     budgeted = math.isfinite(deadline)
     for index in range(wanted + (MAX_SEEDS if budgeted else sc.starts - 1)):
         if best.certified == wanted or (failures == sc.starts and not budgeted):
@@ -114,9 +115,9 @@ def _plan_ipopt(
             failures += 1
             continue
         extra = min(failures, sc.starts - 1)
+        attempt = replace(cfg, optimizer=more_check_points(cfg.optimizer, extra))
         if extra:
-            label = f"{label}, {first + extra} check points per segment"
-        attempt = replace(cfg, optimizer=replace(cfg.optimizer, interpolated=first + extra))
+            label = f"{label}, {attempt.optimizer.interpolated} check points per segment"
         run.exact = None  # a new seed path: the last attempt's coal rows say nothing of it
         q, stats, ok = _solve_refined(problem, model, goal, attempt, guess, run, deadline)
         status = stats.get("return_status", "exception")

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..limits import MAX_REFINE_ROUNDS
 from ..models import DistanceModel
-from .config import PlanConfig
+from .config import PlanConfig, more_check_points
 from .problem import Problem
 from .result import _Run, path_cost
 
@@ -94,9 +94,7 @@ def polish(
         tight = replace(
             cfg,
             refine=replace(cfg.refine, clearance_buffer=buffer, rounds=rounds),
-            optimizer=replace(
-                opt, interpolated=opt.interpolated + extra, obj_change_tol=stop, max_iter=cap
-            ),
+            optimizer=replace(more_check_points(opt, extra), obj_change_tol=stop, max_iter=cap),
         )
         t0, before, cert = time.perf_counter(), path_cost(run.q), run.verified
         q, ok = _again(problem, model, goal, tight, run, deadline)
@@ -136,7 +134,7 @@ def repair(
     wide = replace(
         cfg,
         refine=replace(ref, clearance_buffer=ref.clearance_buffer + REPAIR_BUFFER, rounds=rounds),
-        optimizer=replace(opt, interpolated=opt.interpolated + REPAIR_EXTRA),
+        optimizer=more_check_points(opt, REPAIR_EXTRA),
     )
     t0 = time.perf_counter()
     q, ok = _again(problem, model, goal, wide, run, deadline)
