@@ -146,6 +146,19 @@ def shown(value: object, limit: int = 40) -> str:
     return text if len(text) <= limit else f"{text[:limit]}…"
 
 
+def floor_text(lower_bound: float, places: int = 4) -> str:
+    """A proven lower bound (m) as signed text with ``places`` decimals, rounded DOWN (toward
+    −inf), so the printed bound never claims more than was proven: 0.72638 m shows as
+    "+0.7263", not "+0.7264" (``:+.4f`` rounds to nearest and claimed 0.02 mm more). A bound
+    within 10⁻⁶ of a decimal step below it shows as that step (0.0123 stays "+0.0123": binary
+    floats store it a hair under), a claim off by at most 10⁻⁶ of the last place. Non-finite
+    values and magnitudes ≥ 10¹² (no float digits left to round) show as Python formats them."""
+    if not math.isfinite(lower_bound) or abs(lower_bound) >= 1e12:
+        return f"{lower_bound:+.{places}f}"
+    scale = 10**places
+    return f"{math.floor(lower_bound * scale + 1e-6) / scale:+.{places}f}"
+
+
 def read_only(value) -> np.ndarray:
     """A read-only float64 copy of ``value``: geometry that caches (coal shapes, lever arms,
     checkers) is built from such arrays, so an in-place change (``obstacle += offset``) raises

@@ -467,6 +467,24 @@ def test_a_plan_without_obstacles_says_so_not_that_its_clearance_is_unproven(tmp
     assert clearance_text(0.0123) == "certified clearance ≥ +0.0123 m"
 
 
+def test_plan_prints_the_certified_clearance_rounded_down(tmp_path):
+    # a held-out problem (scene (b), seed 7002) whose proven bound is 0.7263805 m: the line said
+    # "certified clearance ≥ +0.7264 m", 0.02 mm more than the certificate proved
+    problem = tmp_path / "b7002.toml"
+    problem.write_text(
+        '[robot]\nname = "planar2"\n\n[scene]\ngenerator = "b"\nseed = 7002\n\n'
+        "[start]\nq = [1.4902181457246444, 1.2165196008289119]\n\n"
+        "[goal]\nq = [2.0507360222777917, 2.1978629242595566]\n\n"
+        "[options]\nwaypoints = 20\nmargin = 0.02\n"
+    )
+    args = ["plan", str(problem), "--collision", "coal", "-q"]
+    text = CliRunner().invoke(app, args)
+    summary = json.loads(CliRunner().invoke(app, [*args, "--json"]).output)
+    assert text.exit_code == 0 and summary["success"], text.output
+    printed = float(text.output.split("certified clearance ≥ ")[1].split(" m")[0])
+    assert printed <= summary["min_distance"] < printed + 1e-4
+
+
 @pytest.mark.parametrize("model", ["graphdistnet", "clearancenet"])
 def test_training_never_replaces_shipped_weights_unless_asked(
     model, captured_training, tmp_path, capsys

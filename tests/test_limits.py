@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 import gdnplan as gp
 from gdnplan.errors import InputError, ProblemFileError
-from gdnplan.limits import check_ipopt, check_number, fits_float, is_number, shown
+from gdnplan.limits import check_ipopt, check_number, fits_float, floor_text, is_number, shown
 from gdnplan.rrt import rrt_connect
 from gdnplan.timing_checks import limit_vector
 
@@ -117,3 +117,22 @@ def test_problem_file_of_an_overlong_integer(tmp_path):
     )
     with pytest.raises(ProblemFileError, match=r"p\.toml: a number too long to read"):
         gp.Problem.from_toml(path)
+
+
+@given(st.floats(min_value=-1e6, max_value=1e6, allow_nan=False))
+@example(0.7263805400037253)  # a held-out plan's proven bound: ":+.4f" printed "+0.7264"
+@example(-0.00004)  # ":+.4f" printed "-0.0000", above the bound
+@example(0.0123)  # stored a hair under 0.0123: still shows "+0.0123"
+def test_floor_text_never_claims_more_than_the_bound(x):
+    """A printed lower bound is rounded down: at most 10⁻⁶ of the last place above the value
+    (the floats a hair under a decimal step), never a rounding step above it."""
+    shown_value = float(floor_text(x))
+    assert shown_value <= x + 1e-6 * 1e-4 * (1 + abs(x))
+    assert shown_value > x - 1e-4 - 1e-9 * (1 + abs(x))
+
+
+def test_floor_text_keeps_exact_steps_and_non_finite_values():
+    assert floor_text(0.0123) == "+0.0123" and floor_text(0.02) == "+0.0200"
+    assert floor_text(0.7263805400037253) == "+0.7263"
+    assert floor_text(-0.00004) == "-0.0001"
+    assert floor_text(float("inf")) == "+inf" and floor_text(1e300) == f"{1e300:+.4f}"

@@ -7,6 +7,8 @@ import math
 
 import typer
 
+from ..limits import floor_text
+
 
 def echo_stages(stages, grippers) -> float:
     """Print one line per fetch stage (name, gripper, planned/scripted, verdict, clearance,
@@ -40,13 +42,14 @@ def timing_text(traj) -> str:
 
 
 def clearance_text(lower_bound: float) -> str:
-    """'certified clearance ≥ +0.0123 m'; 'nothing to collide with' for a +inf bound (no
-    obstacles, no self-collision pairs), 'clearance not proven' for −inf (or NaN)."""
+    """'certified clearance ≥ +0.0123 m' (rounded down, :func:`~gdnplan.limits.floor_text`:
+    never more than was proven); 'nothing to collide with' for a +inf bound (no obstacles, no
+    self-collision pairs), 'clearance not proven' for −inf (or NaN)."""
     if lower_bound == math.inf:
         return "nothing to collide with (no obstacles)"
     if not math.isfinite(lower_bound):
         return "clearance not proven"
-    return f"certified clearance ≥ {lower_bound:+.4f} m"
+    return f"certified clearance ≥ {floor_text(lower_bound)} m"
 
 
 def json_number(x: float) -> float | None:

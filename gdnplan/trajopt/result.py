@@ -12,6 +12,7 @@ import numpy as np
 from ..ccd import Certificate
 from ..errors import InputError
 from ..exact import certify
+from ..limits import floor_text
 from ..timing import TimedTrajectory
 from .ik import tip_position
 from .problem import Problem
@@ -180,7 +181,7 @@ def _finish(problem: Problem, run: _Run, t0: float) -> Plan:
             "and keeps every constraint (certified clearance, goal, joint limits, max_step)"
         )
     ok = cert is not None and cert.ok
-    verdict = f"ok, clearance ≥ {cert.lower_bound:+.4f} m" if ok else "not proven"
+    verdict = f"ok, clearance ≥ {floor_text(cert.lower_bound)} m" if ok else "not proven"
     why = "" if not ok or success else ("; goal not reached" if not reached else f"; {broken}")
     log.info("certify: coal certificate %s%s", verdict, why)
     return Plan(
