@@ -132,6 +132,46 @@ def test_a_seed_kind_of_the_wrong_shape_is_an_input_error(monkeypatch):
         plan(problem, collision="coal", solver=PlanConfig(seed=SeedConfig(kinds=("short",))))
 
 
+HOSTILE_GUESSES = {  # what a caller's seed kind might return instead of a (T, dof) path
+    "strings": lambda t, n: [["a"] * n] * t,  # ValueError from np.asarray(dtype=float)
+    "ragged": lambda t, n: [[0.0] * n] * (t - 1) + [[0.0]],  # ValueError (inhomogeneous)
+    "dict": lambda t, n: {"q": 0},  # TypeError
+    "complex": lambda t, n: np.full((t, n), 0.5 + 1j),  # the imaginary part silently dropped
+    "bool": lambda t, n: np.ones((t, n), bool),  # planned from 1 rad
+    "nan": lambda t, n: np.full((t, n), np.nan),  # Invalid_Number_Detected / "q: contains NaN"
+    "inf": lambda t, n: np.full((t, n), -np.inf),
+    "object": lambda t, n: np.array([[0.1, None]] * t, dtype=object)[:, :n],
+}
+
+
+@settings(max_examples=12, deadline=None)
+@given(name=st.sampled_from(sorted(HOSTILE_GUESSES)), row=st.integers(0, 19))
+@example(name="strings", row=0)
+@example(name="complex", row=3)
+def test_a_seed_kind_returning_no_real_finite_path_is_an_input_error(name, row):
+    """A seed kind's path must be real finite numbers of shape (T, dof): anything else is an
+    InputError naming the kind, before any solve (one bad row is enough)."""
+    from gdnplan.trajopt.seeds import checked_guess
+
+    problem = Problem.from_toml("planar2_square")
+    t, n = problem.waypoints, problem.scene.robot.dof
+    bad = HOSTILE_GUESSES[name](t, n)
+    if isinstance(bad, np.ndarray) and bad.shape == (t, n):  # one bad row in a good path
+        good = straight_line(problem.start, problem.goal, t).astype(bad.dtype)
+        good[row] = bad[row]
+        bad = good
+    with pytest.raises(gp.InputError, match="seed kind 'probe'"):
+        checked_guess("probe", bad, problem)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setitem(SEED_KINDS, "probe", lambda request: bad)
+        cfg = PlanConfig(seed=SeedConfig(initial="rrt", kinds=("probe",), count=1, starts=1))
+        with pytest.raises(gp.InputError, match="seed kind 'probe'"):
+            plan(problem, collision="coal", solver=cfg)
+    line = straight_line(problem.start, problem.goal, t)
+    for fine in (line.tolist(), line.astype(np.float32), np.rint(line).astype(int)):
+        np.testing.assert_array_equal(checked_guess("probe", fine, problem), np.asarray(fine))
+
+
 class FakeClock:
     """A ``time`` module stand-in for the planner: ``perf_counter`` advances 1 µs a call, and
     ``step`` seconds whenever :meth:`tick` (a seed kind's work) runs."""

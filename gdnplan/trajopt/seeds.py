@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..exact import exact_distance
+from ..limits import shown
 from ..path_metrics import resample_arc_length
 from ..rrt import resample, rrt_connect, seed_path, shortcut
 from .check_points import straight_line
@@ -211,6 +212,33 @@ def register_seed_kind(name: str, source: SeedSource) -> None:
     SEED_KINDS[name] = source
 
 
+def checked_guess(kind: str, guess, problem: Problem) -> np.ndarray:
+    """A seed kind's path as float64 (T, dof) rad: real finite numbers of the problem's shape,
+    else InputError naming the kind (strings, ragged lists or a dict raised numpy's ValueError
+    or TypeError; a complex path lost its imaginary part, bools passed as 0/1 rad, NaN reached
+    Ipopt or a learned model). Waypoints outside the joint limits are clipped by the solve, and
+    the ends are the problem's start and goal whatever the path holds there."""
+    shape = (problem.waypoints, problem.scene.robot.dof)
+    try:
+        arr = np.asarray(guess)
+    except (TypeError, ValueError):  # ragged rows
+        arr = np.asarray(None)
+    if arr.dtype.kind not in "iuf":
+        raise InputError(
+            f"seed kind {kind!r}: returned {shown(guess)} ({arr.dtype} of shape {arr.shape}); "
+            f"expected a real (T, dof) = {shape} array of joint angles (rad) or None"
+        )
+    if arr.shape != shape:
+        raise InputError(f"seed kind {kind!r}: returned shape {arr.shape}, expected {shape}")
+    arr = arr.astype(float)
+    if not np.all(np.isfinite(arr)):
+        raise InputError(
+            f"seed kind {kind!r}: returned a path holding NaN or infinite joint values; return "
+            "finite joint angles (rad), or None when it finds no path"
+        )
+    return arr
+
+
 def draw_seed(
     kind: str,
     problem: Problem,
@@ -238,12 +266,7 @@ def draw_seed(
         if guess is not None:
             break
     if guess is not None:
-        guess = np.asarray(guess, dtype=float)
-        if guess.shape != (problem.waypoints, problem.scene.robot.dof):
-            raise InputError(
-                f"seed kind {kind!r}: returned shape {guess.shape}, expected "
-                f"({problem.waypoints}, {problem.scene.robot.dof})"
-            )
+        guess = checked_guess(kind, guess, problem)
     found = "path found" if guess is not None else "no path"
     log.info("seed: %s: %s, %.2f s", label, found, time.perf_counter() - t0)
     return guess, label + (" (clearance = margin)" if demand < clearance else "")
@@ -255,6 +278,7 @@ __all__ = [
     "SeedRequest",
     "SeedSource",
     "aorrtc_seed",
+    "checked_guess",
     "draw_seed",
     "register_seed_kind",
     "rrt_seed",
