@@ -410,3 +410,15 @@ def replace_limits(problem: Problem, lower, upper) -> Problem:
         problem.scene, problem.start, problem.goal, waypoints=problem.waypoints,
         margin=problem.margin, lower=lower, upper=upper,
     )  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", [np.int64(5), np.uint32(5), np.int8(5)])
+def test_a_numpy_seed_gives_the_plan_of_its_int_and_json_ready_seed_info(seed):
+    """plan(seed=np.int64(5)) plans as seed=5; the winner's SeedInfo held numpy integers
+    (stream = seed + index), which json.dumps refused."""
+    problem = Problem.from_toml("planar2_square")
+    cfg = unpolished(2)
+    ours, theirs = plan(problem, "coal", solver=cfg, seed=seed), plan(problem, "coal", cfg, seed=5)
+    np.testing.assert_array_equal(ours.q, theirs.q)
+    assert type(ours.seed.stream) is int and type(ours.seed.index) is int
+    assert json.loads(json.dumps(ours.seed.summary())) == theirs.seed.summary()

@@ -154,7 +154,7 @@ def plan(
     t0 = time.perf_counter()
     if not isinstance(problem, Problem):
         raise InputError(f"problem: expected a gdnplan.Problem, got {type(problem).__name__}")
-    check_int(seed, "seed", 0, MAX_SEED)
+    seed = check_int(seed, "seed", 0, MAX_SEED)  # a Python int: a numpy seed reached Plan.seed
     cfg = plan_config(problem, solver, options)
     _check_sizes(problem, cfg)
     dof = problem.scene.robot.dof
@@ -249,7 +249,7 @@ def numeric_ik(
     """
     if not isinstance(problem, Problem) or problem.goal_position is None:
         raise InputError("problem: expected a gdnplan.Problem with a goal position")
-    check_int(seed, "seed", 0, MAX_SEED)
+    seed = check_int(seed, "seed", 0, MAX_SEED)
     check_int(restarts, "restarts", 0, 10_000)
     check_int(iterations, "iterations", 1, MAX_ITER)
     robot, target = problem.scene.robot, problem.goal_position
