@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import numbers
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -157,6 +157,18 @@ def floor_text(lower_bound: float, places: int = 4) -> str:
         return f"{lower_bound:+.{places}f}"
     scale = 10**places
     return f"{math.floor(lower_bound * scale + 1e-6) / scale:+.{places}f}"
+
+
+def plain_fields(settings: object) -> None:
+    """Each numpy scalar field of the (frozen) dataclass ``settings`` replaced by its Python
+    value (``np.int8(50)`` → 50, ``np.float32(0.5)`` → 0.5): numpy integers keep their width
+    in arithmetic, so ``interpolated = np.int8(50)`` made int8 check-point counts that the
+    refine rounds doubled past 127 to negative (the check points vanished), and numpy values
+    do not serialise to JSON."""
+    for item in fields(settings):
+        value = getattr(settings, item.name)
+        if isinstance(value, np.generic):
+            object.__setattr__(settings, item.name, value.item())
 
 
 def read_only(value) -> np.ndarray:

@@ -4,14 +4,19 @@ bools, floats, strings and values out of range are InputErrors naming the field 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from gdnplan.errors import InputError
 from gdnplan.limits import check_int, shown
 from gdnplan.models import fields
 from gdnplan.models import threads as th
 from gdnplan.train.fit import FitConfig
+from gdnplan.trajopt.config import CONFIG_TABLES
 
 
 @pytest.mark.parametrize("value", [1, 5, np.int64(5), np.uint8(3), 10])
@@ -67,3 +72,45 @@ def test_make_scene_seeds_use_it(seed):
     with pytest.raises(InputError, match=r"^seed: expected an integer ≥ 0, got "):
         make_scene("a", seed=seed)
     assert make_scene("a", seed=np.int64(3)).seed == 3
+
+
+NUMPY_INTS = [np.int8, np.int16, np.uint8, np.uint16, np.int32, np.int64]
+
+
+@settings(max_examples=40, deadline=None)
+@given(kind=st.sampled_from(["seed", "refine", "ipopt", "adam"]), data=st.data())
+@example(kind="ipopt", data=None)
+def test_planner_configs_hold_python_scalars_whatever_the_caller_gave(kind, data):
+    """A numpy scalar given for a planner setting is stored as its Python value: numpy
+    integers keep their width, so IpoptConfig(interpolated=np.int8(50)) made int8 check-point
+    counts that the refine rounds doubled past 127 to negative (the check points vanished)."""
+    cls = CONFIG_TABLES[kind]
+    if data is None:  # the crafted case: int8 check points doubled by the refine rounds
+        cfg = cls(interpolated=np.int8(50))
+        splits = np.full(4, cfg.interpolated + 1)
+        assert np.all(splits * 2**8 > 0)
+        return
+    values = {}
+    for item in dataclasses.fields(cls):
+        default = getattr(cls(), item.name)
+        if isinstance(default, bool):
+            values[item.name] = np.bool_(default)
+        elif isinstance(default, int):
+            fits = [t for t in NUMPY_INTS if np.iinfo(t).max >= default]
+            values[item.name] = data.draw(st.sampled_from(fits))(default)
+        elif isinstance(default, float):
+            values[item.name] = data.draw(st.sampled_from([np.float32, np.float64]))(default)
+    cfg = cls(**values)
+    for name, value in values.items():
+        got = getattr(cfg, name)
+        assert type(got) in (bool, int, float) and got == value.item()
+
+
+def test_a_problem_holds_python_scalars():
+    from gdnplan.trajopt import Problem
+
+    base = Problem.from_toml("planar2_square")
+    p = Problem(base.scene, base.start, base.goal, waypoints=np.int8(100), margin=np.float32(0.02),
+                max_step=np.float64(1.0), clearance=np.float32(0.01))  # fmt: skip
+    assert type(p.waypoints) is int and (p.waypoints - 1) * 60 == 5940  # int8 wrapped
+    assert type(p.margin) is float and type(p.max_step) is float

@@ -35,6 +35,7 @@ from ..limits import (
     check_int,
     check_ipopt,
     check_number,
+    plain_fields,
 )
 from .seed_config import DEFAULT_SEEDS as DEFAULT_SEEDS
 from .seed_config import INITIAL_GUESSES as INITIAL_GUESSES
@@ -89,6 +90,7 @@ class RefineConfig:
     repair: bool = True
 
     def __post_init__(self) -> None:
+        plain_fields(self)
         _check_bools(self, ("ccd", "warm_start", "exact_rows", "polish", "repair"))
         check_int(self.rounds, "rounds", 0, MAX_REFINE_ROUNDS)
         check_number(self.clearance_buffer, "clearance_buffer")
@@ -128,6 +130,7 @@ class IpoptConfig:
     options: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        plain_fields(self)
         check_int(self.interpolated, "interpolated", 0, MAX_INTERPOLATED)
         if self.per_link is not None:
             _check_bools(self, ("per_link",))
@@ -160,6 +163,7 @@ class AdamConfig:
     stop: float = 0.01
 
     def __post_init__(self) -> None:
+        plain_fields(self)
         check_int(self.interpolated, "interpolated", 0, MAX_INTERPOLATED)
         check_int(self.iterations, "iterations", 1, MAX_ADAM_ITERATIONS)
         for name in ("lr", "c", "eps"):

@@ -20,6 +20,7 @@ from ..limits import (
     check_int,
     check_ipopt,
     check_number,
+    plain_fields,
 )
 from .config import (
     INITIAL_GUESSES,
@@ -147,6 +148,7 @@ class TrajoptOptions:
     def __post_init__(self) -> None:
         """InputError naming the setting for a wrong type, NaN/inf or a value past its limit
         (limits in :mod:`gdnplan.limits`)."""
+        plain_fields(self)
         if self.initial not in INITIAL_GUESSES:
             raise InputError(f"initial: unknown {self.initial!r}; choose one of {INITIAL_GUESSES}")
         for name in ("ccd", "warm_start") + (("per_link",) if self.per_link is not None else ()):

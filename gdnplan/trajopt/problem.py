@@ -21,7 +21,7 @@ from ..assets import problem_file
 from ..ccd import proven_distance
 from ..errors import InfeasibleProblemError, InputError, ProblemFileError
 from ..exact import closest_pair, exact_distance, swept_radius_of
-from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number, shown
+from ..limits import MAX_WAYPOINTS, check_int, check_number, is_number, plain_fields, shown
 from ..robot import first_outside
 from ..scene import Scene
 from .config import PlanConfig
@@ -101,6 +101,7 @@ class Problem:
         return self.margin if self.clearance is None else self.clearance
 
     def __post_init__(self) -> None:
+        plain_fields(self)  # numpy scalars as Python values (numpy integers wrap)
         if not isinstance(self.scene, (Scene, Scene3D)):
             raise InputError(
                 f"scene: expected a planar Scene or a Scene3D, got {type(self.scene).__name__}"

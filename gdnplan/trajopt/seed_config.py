@@ -16,6 +16,7 @@ from ..limits import (
     MAX_TIME_BUDGET,
     check_int,
     check_number,
+    plain_fields,
     shown,
 )
 
@@ -66,6 +67,7 @@ class SeedConfig:
     rrt_clearance: float = 0.02
 
     def __post_init__(self) -> None:
+        plain_fields(self)
         if self.initial not in INITIAL_GUESSES:
             raise InputError(
                 f"initial: unknown {shown(self.initial)}; choose one of {INITIAL_GUESSES}"
