@@ -233,7 +233,41 @@ def write(records: list[dict], head: str, out: Path) -> None:
     out.write_text(text + table(records) + NOTES)
 
 
-def main() -> None:
+def check_args(args: argparse.Namespace) -> None:
+    """Every flag checked before any work (InputError naming it): an unknown --envs name raised
+    KeyError, --budgets nan or -1 and --planners or --kinds unknown to OMPL or gdnplan raised
+    tracebacks after gdnplan's solves of the first problem had run, and --threads 0 raised
+    torch's RuntimeError; --problems 0 or --first -5 wrote an empty table."""
+    from gdnplan.errors import InputError
+    from gdnplan.files import check_output_path
+    from gdnplan.limits import check_int, check_number
+    from gdnplan.models.threads import check_threads
+    from gdnplan.ompl_planner import MAX_OMPL_SEED, MAX_TIME, PLANNERS
+    from gdnplan.trajopt import SeedConfig
+
+    check_threads(args.threads, "--threads", default=False)
+    for env in args.envs:
+        if env not in WEIGHTS_ENV:
+            raise InputError(f"--envs: unknown {env!r}; choose from {sorted(WEIGHTS_ENV)}")
+    check_int(args.problems, "--problems", 1)
+    check_int(args.first, "--first", 0)
+    for budget in args.budgets:
+        if check_number(budget, "--budgets", strict=True) > MAX_TIME:
+            raise InputError(f"--budgets: {budget:g} s is over OMPL's limit {MAX_TIME:g} s")
+    for planner in args.planners:
+        if planner not in PLANNERS:
+            raise InputError(f"--planners: unknown {planner!r}; choose from {sorted(PLANNERS)}")
+    check_int(args.seed, "--seed", 0, MAX_OMPL_SEED)
+    try:
+        SeedConfig(count=args.seeds, kinds=tuple(args.kinds or SeedConfig.kinds))
+    except InputError as e:
+        raise InputError(f"--seeds/--kinds: {e}") from e
+    check_output_path(args.out, (".md",), "--out")
+    if args.render is not None and not args.render.is_file():
+        raise InputError(f"--render: {str(args.render)!r} is no records file (.jsonl)")
+
+
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--threads", type=int, default=1, help="torch threads")
     parser.add_argument("--envs", nargs="+", default=["b", "d", "fetch"])
@@ -248,7 +282,11 @@ def main() -> None:
     parser.add_argument(
         "--render", type=Path, help="only rewrite --out from this records file (.jsonl)"
     )
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    try:
+        check_args(args)
+    except gp.GdnplanError as e:
+        parser.error(str(e))  # exit status 2, no traceback
     if args.render:
         records = [json.loads(ln) for ln in args.render.read_text().splitlines() if ln]
         old = args.out.read_text().splitlines() if args.out.exists() else []
@@ -261,7 +299,8 @@ def main() -> None:
 
     torch.set_num_threads(args.threads)
     set_inference_threads(args.threads)
-    command = "python benchmarks/ompl_compare.py " + shlex.join(sys.argv[1:])
+    given = sys.argv[1:] if argv is None else argv
+    command = "python benchmarks/ompl_compare.py " + shlex.join(given)
     jsonl = args.out.with_suffix(".jsonl")
     jsonl.parent.mkdir(parents=True, exist_ok=True)
     jsonl.write_text("")

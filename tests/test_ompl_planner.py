@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -92,3 +93,36 @@ def test_a_box_within_the_robots_limits_is_accepted(square):
     )
     assert r.path.shape[1] == 2
     assert np.all(r.path >= p.lower * 0.99 - 1e-12)
+
+
+BAD_COMPARE_FLAGS = [
+    (["--envs", "zz"], "--envs: unknown 'zz'"),  # KeyError
+    (["--problems", "0"], "--problems"),  # an empty table
+    (["--first", "-5"], "--first"),
+    (["--budgets", "nan"], "--budgets"),  # InputError traceback after gdnplan's solves
+    (["--budgets", "1e9"], "--budgets"),
+    (["--planners", "nosuch"], "--planners: unknown 'nosuch'"),
+    (["--threads", "0"], "--threads"),  # torch's RuntimeError
+    (["--seeds", "0"], "--seeds/--kinds"),
+    (["--kinds", "nosuch"], "--seeds/--kinds"),
+    (["--seed", "-1"], "--seed"),
+    (["--render", "/no/such.jsonl"], "--render"),
+    (["--out", "table.txt"], "--out"),
+]
+
+
+@pytest.mark.parametrize(("flags", "message"), BAD_COMPARE_FLAGS, ids=lambda x: str(x)[:30])
+def test_ompl_compare_refuses_bad_flags_before_any_work(flags, message, capsys, monkeypatch):
+    """benchmarks/ompl_compare.py checks every flag up front: exit status 2 and one line naming
+    the flag, before a problem is drawn or a results file truncated."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "ompl_compare.py"
+    spec = importlib.util.spec_from_file_location("ompl_compare", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    monkeypatch.setattr(module, "reaching_problems", lambda *a, **k: pytest.fail("work began"))
+    with pytest.raises(SystemExit) as e:
+        module.main(["--out", "/tmp/never_written.md", *flags])
+    assert e.value.code == 2
+    assert message in capsys.readouterr().err
