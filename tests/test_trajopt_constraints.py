@@ -176,3 +176,28 @@ def test_plan_refuses_a_non_problem():
 def test_any_allowed_seed_plans(square, seed):
     result = plan(square, collision="coal", seed=seed, solver=PlanConfig(SeedConfig(count=1)))
     assert result.success, result.reason
+
+
+def test_the_check_point_limit_counts_the_planners_own_additions():
+    """MAX_CHECK_POINTS bounds every solve before refining, the polish's and the repair's
+    (two more check points per segment) included: T = 500, interpolated = 39 and one start
+    passed (499 · 40 = 19 960) while the polish solved with 499 · 42 = 20 958; the limit is
+    checked before any solve, and without the polish and repair those settings plan."""
+    from gdnplan.trajopt import IpoptConfig, planner
+
+    problem = Problem.from_toml("planar2_square")
+    big = replace_waypoints(problem, 500)
+    seed = SeedConfig(starts=1)
+    cfg = PlanConfig(seed, RefineConfig(), IpoptConfig(interpolated=39))
+    with pytest.raises(InputError, match="20958 check points, the limit is 20000"):
+        plan(big, "coal", solver=cfg)
+    bare = PlanConfig(seed, RefineConfig(polish=False, repair=False), IpoptConfig(interpolated=39))
+    planner._check_sizes(big, bare)  # 19 960: within the limit
+    adam = PlanConfig(seed, optimizer=AdamConfig(interpolated=39))
+    planner._check_sizes(big, adam)  # Adam adds none
+
+
+def replace_waypoints(problem: Problem, waypoints: int) -> Problem:
+    """``problem`` with ``waypoints`` waypoints."""
+    return Problem(problem.scene, problem.start, problem.goal, waypoints=waypoints,
+                   margin=problem.margin)  # fmt: skip

@@ -21,11 +21,18 @@ from ..models import CoalModel, DistanceModel, load_model
 from ..scene import Scene
 from ..timing import limit_vector, plan_timing
 from .adam import _plan_adam
-from .config import AdamConfig, IpoptConfig, PlanConfig, finite_budget, with_optimizer
+from .config import (
+    AdamConfig,
+    IpoptConfig,
+    PlanConfig,
+    finite_budget,
+    more_check_points,
+    with_optimizer,
+)
 from .ik import first_joint_barrier, tip_point, tip_position
 from .ipopt import _plan_ipopt
 from .options import TrajoptOptions
-from .polish import polish, repair
+from .polish import POLISH_STAGES, REPAIR_EXTRA, polish, repair
 from .problem import Problem, check_reachable_in_steps
 from .result import Plan, _finish
 
@@ -226,8 +233,21 @@ def plan_config(
 
 
 def _check_sizes(problem: Problem, cfg: PlanConfig) -> None:
-    """InputError when the first solve would exceed ``MAX_CHECK_POINTS`` check points."""
-    per_segment = cfg.interpolated + cfg.seed.starts
+    """InputError when a solve before refining would exceed ``MAX_CHECK_POINTS`` check points:
+    the first, or one with the planner's own additions (a replaced attempt: up to starts − 1;
+    the polish and repair: ``POLISH_STAGES``' and ``REPAIR_EXTRA``; all capped by
+    :func:`~.config.more_check_points`). Counting ``starts − 1`` alone let the polish of a
+    one-start call exceed the limit by 2 (T − 1) check points."""
+    extra = cfg.seed.starts - 1
+    if isinstance(cfg.optimizer, IpoptConfig):
+        extra = max(
+            extra,
+            max(e for _, e, _ in POLISH_STAGES) if cfg.refine.polish else 0,
+            REPAIR_EXTRA if cfg.refine.repair else 0,
+        )
+        per_segment = more_check_points(cfg.optimizer, extra).interpolated + 1
+    else:  # Adam keeps its check points
+        per_segment = cfg.interpolated + 1
     total = (problem.waypoints - 1) * per_segment
     if total > MAX_CHECK_POINTS:
         raise InputError(
