@@ -69,6 +69,7 @@ def toppra_profile(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> Sm
         ) from e
 
     logging.getLogger("toppra").setLevel(logging.ERROR)
+    scale = time_scale(v, a)
     segments = len(knots) - 1
     m = max(2, min(GRID_PER_SEGMENT, MAX_GRID // (2 * segments)))
     cells = np.linspace(0.0, 1.0, m + 1)[:-1]
@@ -76,15 +77,26 @@ def toppra_profile(curve, knots: np.ndarray, v: np.ndarray, a: np.ndarray) -> Sm
     for offset in BEFORE_KNOT:  # the closest first; toppra may call a grid uncontrollable
         before = knots[1:-1] - offset * np.diff(knots)[:-1]  # p'' jumps at every knot
         grid = np.unique(np.concatenate([cells, before if offset else [], knots[-1:]]))
-        prof = _toppra_on_grid(curve, knots, grid, v, a)
+        prof = _toppra_on_grid(curve, knots, grid, v, a, scale)
         if prof is not None:
             return prof
     return None
 
 
-def _toppra_on_grid(curve, knots, grid, v, a) -> SmoothProfile | None:
-    """toppra on one grid (None when it finds no parametrisation); the time stretch c makes
-    the limits hold on every cell whatever the grid (:func:`cell_bounds`)."""
+def time_scale(v: np.ndarray, a: np.ndarray) -> float:
+    """λ > 0 with min(min_j v_j λ, √(min_j a_j) λ) = 1: toppra runs under the limits v λ and
+    a λ², whose path speed ṡ is of order 1, and its ṡ is divided by λ (a time-optimal
+    parametrisation scales exactly so). toppra's tolerances are absolute: under
+    a = 1e-6 rad/s² (ṡ ~ 1e-3) its ṡ broke the acceleration limit between grid points so far
+    that the stretch c was 25 (1.02 under a = 1): the smooth timing took 83 000 s where
+    stopping at every waypoint took 12 000 s."""
+    return 1.0 / min(float(np.min(v)), math.sqrt(float(np.min(a))))
+
+
+def _toppra_on_grid(curve, knots, grid, v, a, scale: float = 1.0) -> SmoothProfile | None:
+    """toppra on one grid under the limits v ``scale`` and a ``scale``² (:func:`time_scale`),
+    its ṡ divided by ``scale`` (None when it finds no parametrisation); the time stretch c
+    makes the limits v, a hold on every cell whatever the grid (:func:`cell_bounds`)."""
     import toppra
     import toppra.algorithm
     import toppra.constraint as tc
@@ -98,9 +110,10 @@ def _toppra_on_grid(curve, knots, grid, v, a) -> SmoothProfile | None:
             return curve(s, order)
 
     constraints = [
-        tc.JointVelocityConstraint(np.column_stack([-v, v])),
+        tc.JointVelocityConstraint(np.column_stack([-v, v]) * scale),
         tc.JointAccelerationConstraint(
-            np.column_stack([-a, a]), discretization_scheme=tc.DiscretizationType.Interpolation
+            np.column_stack([-a, a]) * scale**2,
+            discretization_scheme=tc.DiscretizationType.Interpolation,
         ),
     ]
     algo = toppra.algorithm.TOPPRA(constraints, Path(), gridpoints=grid)
@@ -109,7 +122,7 @@ def _toppra_on_grid(curve, knots, grid, v, a) -> SmoothProfile | None:
     sd = data.sd_vec
     if data.return_code != ParameterizationReturnCode.Ok or sd is None:
         return None
-    sd = np.maximum(np.asarray(sd, float), 0.0)
+    sd = np.maximum(np.asarray(sd, float), 0.0) / scale
     if not np.all(np.isfinite(sd)) or np.any(sd[1:] + sd[:-1] <= 0):
         return None
     prof = SmoothProfile(curve, grid, sd)
@@ -173,5 +186,6 @@ __all__ = [
     "chord_knots",
     "max_abs_quadratic",
     "pchip_curve",
+    "time_scale",
     "toppra_profile",
 ]

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-from hypothesis import example, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import CubicSpline, PchipInterpolator
 from typer.testing import CliRunner
@@ -144,6 +144,28 @@ def test_smooth_respects_the_limits_and_stays_in_the_waypoint_boxes(free, case):
     k = np.clip(np.searchsorted(traj.times, tt, side="right") - 1, 0, len(q) - 2)
     lo, hi = np.minimum(q[k], q[k + 1]), np.maximum(q[k], q[k + 1])
     assert np.all((q_all >= lo - 1e-9) & (q_all <= hi + 1e-9))
+
+
+@settings(max_examples=15, deadline=None)
+@given(paths(dofs=(2, 7)), st.floats(-2.5, 3.0))
+@example(SHORT_TURN, -2.5)
+def test_the_smooth_timing_does_not_depend_on_the_units_of_time(free, case, exponent):
+    """Limits v k and a k² give the same motion k times faster (a time-optimal timing scales
+    exactly so). toppra's tolerances are absolute: under small limits (a ~ 1e-6 rad/s²) its
+    path speed broke the acceleration limit between grid points so far that the stretch was
+    25 (1.02 at a ~ 1), and the smooth timing took 7 times longer than stopping at every
+    waypoint (timing_toppra.time_scale normalises the limits first)."""
+    q, v, a = case
+    assume(not np.all(q == q[0]))
+    k = 10.0**exponent
+    base, scaled = (
+        time_path(q, v, a, free[q.shape[1]]),
+        time_path(q, v * k, a * k**2, free[q.shape[1]]),
+    )
+    assert base.kind == scaled.kind == "smooth"
+    assert scaled.duration * k == pytest.approx(base.duration, rel=0.02)
+    _, qd, qdd = scaled.evaluate(np.linspace(0.0, scaled.duration, 4000))
+    assert np.all(np.abs(qd) <= v * k * (1 + REL)) and np.all(np.abs(qdd) <= a * k**2 * (1 + REL))
 
 
 @settings(max_examples=30, deadline=None)
