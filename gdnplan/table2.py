@@ -41,6 +41,7 @@ from .assets import WEIGHTS_DIR
 from .ccd import verify_path
 from .distance import signed_distance
 from .errors import InfeasibleProblemError, InputError
+from .limits import floor_text
 from .models import CoalModel, DistanceModel, load_model
 from .rrt import rrt_connect
 from .scene import make_scene
@@ -166,7 +167,7 @@ def run_setting(
                 records.append(_record(setting, method, solver, i, r, prep))
                 log(
                     f"{setting} #{i} {method}+{solver}: {'ok' if r.success else 'FAIL'} "
-                    f"{r.min_distance:+.4f} m {r.solve_time:.2f} s {r.status}"
+                    f"{floor_text(r.min_distance)} m {r.solve_time:.2f} s {r.status}"
                 )
     return records, skipped
 
