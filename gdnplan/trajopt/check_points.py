@@ -6,6 +6,7 @@ the margin)."""
 from __future__ import annotations
 
 import numpy as np
+from scipy import sparse
 
 from ..arm3d.distance3d import Coal3DModel
 from ..exact import exact_distance
@@ -38,20 +39,21 @@ def _path_parameters(splits: np.ndarray) -> np.ndarray:
     return np.concatenate([*parts, [float(len(splits))]])
 
 
-def _interpolation_matrix(splits: np.ndarray) -> np.ndarray:
-    """(Σ n_t + 1, T) weights: row k of W·Q is the k-th check point along the path, with
-    segment t split into n_t = splits[t] pieces."""
+def _interpolation_matrix(splits: np.ndarray) -> sparse.csr_matrix:
+    """(Σ n_t + 1, T) sparse weights: row k of W·Q is the k-th check point along the path,
+    with segment t split into n_t = splits[t] pieces (two nonzeros per row: 1 − i/n_t at
+    waypoint t, i/n_t at t + 1; the last row is the goal). Sparse: refine rounds double the
+    rejected segments' pieces, and a dense (K, T) array grew by K·T·8 bytes."""
+    splits = np.asarray(splits, dtype=np.int64)
     T = len(splits) + 1
-    rows = []
-    for t, n_t in enumerate(splits):
-        for i in range(n_t):
-            w = np.zeros(T)
-            w[t], w[t + 1] = 1 - i / n_t, i / n_t
-            rows.append(w)
-    last = np.zeros(T)
-    last[-1] = 1.0
-    rows.append(last)
-    return np.array(rows)
+    seg = np.repeat(np.arange(T - 1), splits)  # the segment of each check point
+    first = np.repeat(np.cumsum(splits) - splits, splits)  # row of each segment's waypoint
+    frac = (np.arange(len(seg)) - first) / splits[seg]  # i / n_t
+    k = np.arange(len(seg))
+    rows = np.concatenate([k, k, [len(seg)]])
+    cols = np.concatenate([seg, seg + 1, [T - 1]])
+    vals = np.concatenate([1 - frac, frac, [1.0]])
+    return sparse.csr_matrix((vals, (rows, cols)), shape=(len(seg) + 1, T))
 
 
 def _near_segments(bad: list[int], n: int, window: int | None) -> np.ndarray:
