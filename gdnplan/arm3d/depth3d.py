@@ -42,12 +42,7 @@ def verified_pair(table: PairTable, k: int, tf: np.ndarray) -> float:
     """Proven lower bound (m) on the signed distance of pair k of ``table`` at the shape
     placements ``tf`` (S, 4, 4) (module docstring), without the pair's contact offset."""
     d, _, _, n = table.pair(k, tf)
-    a, b = table.pair_a[k], table.pair_b[k]
-    tf_a = coal.Transform3s(tf[a, :3, :3], tf[a, :3, 3])
-    if table.is_self[k]:
-        tf_b = coal.Transform3s(tf[b, :3, :3], tf[b, :3, 3])
-    else:
-        tf_b = table.scene.obstacles[b].pose
+    tf_a, tf_b = table.pair_poses(k, tf)
     norm = float(np.linalg.norm(n))
     if np.isfinite(d) and np.isfinite(norm) and norm > 0.5:
         t = max(-d, 0.0) + SHIFT

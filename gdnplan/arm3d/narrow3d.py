@@ -150,14 +150,18 @@ class PairTable:
         gap = np.linalg.norm(centers[:, self.pair_a] - other, axis=2)
         return tf, gap - self.radius_sum
 
-    def pair(self, k: int, tf: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
-        """Signed distance (m), witness points p₁, p₂ (3,) and normal n (3,) of pair k."""
+    def pair_poses(self, k: int, tf: np.ndarray) -> tuple[coal.Transform3s, coal.Transform3s]:
+        """coal placements of pair k's two shapes, given the robot shapes' placements ``tf``
+        (S, 4, 4): shape a's, and shape b's (another robot shape's, or the obstacle's pose)."""
         a, b = self.pair_a[k], self.pair_b[k]
         tf_a = coal.Transform3s(tf[a, :3, :3], tf[a, :3, 3])
         if self.is_self[k]:
-            tf_b = coal.Transform3s(tf[b, :3, :3], tf[b, :3, 3])
-        else:
-            tf_b = self.scene.obstacles[b].pose
+            return tf_a, coal.Transform3s(tf[b, :3, :3], tf[b, :3, 3])
+        return tf_a, self.scene.obstacles[b].pose
+
+    def pair(self, k: int, tf: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+        """Signed distance (m), witness points p₁, p₂ (3,) and normal n (3,) of pair k."""
+        tf_a, tf_b = self.pair_poses(k, tf)
         res = self.result
         res.clear()
         self.functors[k](tf_a, tf_b, self.request, res)
