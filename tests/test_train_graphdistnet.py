@@ -144,3 +144,23 @@ def test_library_init_refuses_weights_that_cannot_train(tiny_data, scale, messag
         train("a", tune, data_root=tiny_data, out=tiny_data / "t.safetensors",
               run_dir=tiny_data / "r2")  # fmt: skip
     assert "bad.safetensors" in str(info.value)
+
+
+def test_library_init_takes_a_bare_tensors_file_but_checks_its_values(tiny_data):
+    """A hand-made warm start without a card loads (the warm-start tests write such files);
+    its tensors are still checked: NaN is refused naming the file."""
+    from safetensors.torch import load_file, save_file
+
+    network = GraphDistNetConfig.smooth().with_(layers=1)
+    start = tiny_data / "start.safetensors"
+    train("a", TrainConfig(network, fit=FitConfig(epochs=1)), data_root=tiny_data, out=start,
+          run_dir=tiny_data / "r1")  # fmt: skip
+    tensors = load_file(str(start))
+    save_file(tensors, str(tiny_data / "bare.safetensors"))
+    tune = TrainConfig(network, fit=FitConfig(epochs=1), init=tiny_data / "bare.safetensors")
+    train("a", tune, data_root=tiny_data, out=tiny_data / "t.safetensors", run_dir=tiny_data / "r2")
+    save_file({k: v * float("nan") for k, v in tensors.items()}, str(tiny_data / "nan.safetensors"))
+    tune = TrainConfig(network, fit=FitConfig(epochs=1), init=tiny_data / "nan.safetensors")
+    with pytest.raises(InputError, match=r"nan\.safetensors"):
+        train("a", tune, data_root=tiny_data, out=tiny_data / "u.safetensors",
+              run_dir=tiny_data / "r3")  # fmt: skip

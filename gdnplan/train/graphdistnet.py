@@ -23,7 +23,7 @@ from ..data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from ..errors import InputError
 from ..metrics import roc_auc, sha256_prefix, used_cosine_distances
 from ..models.graphdistnet import GraphDistNet, GraphDistNetConfig
-from ..models.weights import read_card
+from ..models.weights import card_path, read_card
 from .checkpoint import check_resume
 from .fit import fit, validation_split
 from .graphdistnet_config import LEGACY as LEGACY
@@ -51,16 +51,18 @@ def check_env(ds: Dataset, env: str, where: Path | str) -> Dataset:
 
 
 def init_tensors(path: Path) -> dict[str, torch.Tensor]:
-    """The tensors of the ``--init`` weights ``path``: InputError unless its card is planar
-    GraphDistNet's and its tensors are finite, within ±:data:`~gdnplan.models.outputs.MAX_WEIGHT`
-    (3-D weights read as unknown options, NaN or huge ones as a training that diverged)."""
+    """The tensors of the ``--init`` weights ``path``: InputError unless its card (when it has
+    one) is planar GraphDistNet's and its tensors are finite, within ±``MAX_WEIGHT``
+    (:mod:`gdnplan.models.outputs`; 3-D weights read as unknown options, NaN or huge ones as a
+    training that diverged)."""
     from ..models.checks import load_tensors
     from ..models.outputs import check_magnitudes
 
     path = Path(path)
     if not path.exists():
         raise InputError(f"--init: {path} does not exist")
-    model = read_card(path, "--init").get("model")
+    # a bare tensors file (a hand-made warm start) has no card to check; a pair's card must fit
+    model = read_card(path, "--init").get("model") if card_path(path).exists() else "graphdistnet"
     if model != "graphdistnet":
         raise InputError(
             f"--init: {path} holds {model!r} weights; training fine-tunes planar GraphDistNet "
