@@ -23,8 +23,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..exact import exact_distance
-from ..limits import shown
 from ..path_metrics import resample_arc_length
+from ..robot_checks import as_batch
 from ..rrt import resample, rrt_connect, seed_path, shortcut
 from .check_points import straight_line
 from .config import MISSING_SEED_KINDS, SEED_KINDS
@@ -214,27 +214,17 @@ def register_seed_kind(name: str, source: SeedSource) -> None:
 
 def checked_guess(kind: str, guess, problem: Problem) -> np.ndarray:
     """A seed kind's path as float64 (T, dof) rad: real finite numbers of the problem's shape,
-    else InputError naming the kind (strings, ragged lists or a dict raised numpy's ValueError
-    or TypeError; a complex path lost its imaginary part, bools passed as 0/1 rad, NaN reached
-    Ipopt or a learned model). Waypoints outside the joint limits are clipped by the solve, and
-    the ends are the problem's start and goal whatever the path holds there."""
+    else InputError naming the kind (the joint-angle checks of
+    :func:`gdnplan.robot_checks.as_batch`: strings, ragged lists or a dict raised numpy's
+    ValueError or TypeError; a complex path lost its imaginary part, bools passed as 0/1 rad,
+    NaN reached Ipopt or a learned model). Waypoints outside the joint limits are clipped by
+    the solve, and the ends are the problem's start and goal whatever the path holds there."""
     shape = (problem.waypoints, problem.scene.robot.dof)
-    try:
-        arr = np.asarray(guess)
-    except (TypeError, ValueError):  # ragged rows
-        arr = np.asarray(None)
-    if arr.dtype.kind not in "iuf":
+    arr = as_batch(guess, shape[1], f"seed kind {kind!r}: its path")
+    if arr.shape != shape or np.ndim(guess) != 2:
         raise InputError(
-            f"seed kind {kind!r}: returned {shown(guess)} ({arr.dtype} of shape {arr.shape}); "
-            f"expected a real (T, dof) = {shape} array of joint angles (rad) or None"
-        )
-    if arr.shape != shape:
-        raise InputError(f"seed kind {kind!r}: returned shape {arr.shape}, expected {shape}")
-    arr = arr.astype(float)
-    if not np.all(np.isfinite(arr)):
-        raise InputError(
-            f"seed kind {kind!r}: returned a path holding NaN or infinite joint values; return "
-            "finite joint angles (rad), or None when it finds no path"
+            f"seed kind {kind!r}: returned shape {np.shape(guess)}, expected {shape} "
+            "(T, dof) joint angles (rad), or None when it finds no path"
         )
     return arr
 
