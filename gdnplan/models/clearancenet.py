@@ -43,7 +43,7 @@ from .fields import (
     shown,
 )
 from .outputs import finite
-from .settings import MAX_CHUNK, Checked, Fixed
+from .settings import Checked, Fixed, check_chunk_size
 from .threads import check_threads, torch_threads
 from .weights import card_path, read_weights, write_weights
 
@@ -189,7 +189,7 @@ class ClearanceNetModel:
 
     is_distance = True
     threads = Checked(check_threads)  # settable later, checked as here (models/settings.py)
-    chunk = Checked(lambda chunk: check_int(chunk, "chunk", 1, MAX_CHUNK))
+    chunk = Checked(check_chunk_size)
     dtype = Fixed()  # the network's
 
     def __init__(

@@ -45,7 +45,12 @@ def check_device(device) -> torch.device:
 
 def check_chunk(chunk) -> int | None:
     """None (one pass) or an integer in 1 … :data:`MAX_CHUNK`, else InputError."""
-    return None if chunk is None else check_int(chunk, "chunk", 1, MAX_CHUNK)
+    return None if chunk is None else check_chunk_size(chunk)
+
+
+def check_chunk_size(chunk) -> int:
+    """An integer in 1 … :data:`MAX_CHUNK` (configurations per pass), else InputError."""
+    return check_int(chunk, "chunk", 1, MAX_CHUNK)
 
 
 def check_flag(value, name: str, optional: bool = False) -> bool | None:
@@ -105,6 +110,7 @@ __all__ = [
     "Checked",
     "Fixed",
     "check_chunk",
+    "check_chunk_size",
     "check_device",
     "check_dtype",
     "check_flag",

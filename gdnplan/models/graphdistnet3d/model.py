@@ -36,10 +36,9 @@ from ...graph3d import (
     robot_graph3d,
     scene_graph3d,
 )
-from ...limits import check_int
 from ...scene import check_scene
 from ..outputs import finite, overflow_guard
-from ..settings import MAX_CHUNK, Checked, Fixed, check_dtype, check_flag, placed
+from ..settings import Checked, Fixed, check_chunk_size, check_dtype, check_flag, placed
 from ..threads import check_threads, torch_threads
 from . import fused3d
 from .fit import check_fits3d
@@ -126,7 +125,7 @@ class GraphDistNet3DModel:
 
     name = "graphdistnet3d"
     threads = Checked(check_threads)  # settable later, checked as here (models/settings.py)
-    chunk = Checked(lambda chunk: check_int(chunk, "chunk", 1, MAX_CHUNK))
+    chunk = Checked(check_chunk_size)
     contact_offset = Checked(check_offset)
     dtype = Fixed()
 
