@@ -1,7 +1,6 @@
 """gdnplan.data.generate's bounds: n ≤ MAX_SPLIT and workers an int in 1 … MAX_WORKERS, checked
 before anything is planned or written (a huge n used to run silently while memory grew)."""
 
-import time
 
 import pytest
 from tqdm import tqdm
@@ -17,10 +16,9 @@ from gdnplan.errors import InputError
 @pytest.mark.parametrize("n", [MAX_SPLIT + 1, 99999999999999, 0, -3, True, 2.5, "10"])
 def test_a_split_outside_1_to_max_split_is_refused_at_once(tmp_path, n):
     out = tmp_path / "b"
-    t0 = time.perf_counter()
     with pytest.raises(InputError, match="n: expected a number of samples in"):
         generate("b", n, 0, out, workers=1)
-    assert time.perf_counter() - t0 < 1.0 and not out.exists()
+    assert not out.exists()  # refused before any work: no folder, no shard
 
 
 @pytest.mark.parametrize("workers", [0, -1, True, False, 1.0, "2", MAX_WORKERS + 1])
@@ -46,11 +44,10 @@ def test_the_largest_split_is_accepted_by_the_check():
 
 
 def test_cli_refuses_a_huge_n_quickly(tmp_path):
-    t0 = time.perf_counter()
     args = ["generate", "--env", "b", "--n", "99999999999999", "--workers", "1"]
     r = CliRunner().invoke(app, [*args, "--data", str(tmp_path)])
-    assert r.exit_code == 2 and time.perf_counter() - t0 < 5.0
-    assert not any(tmp_path.rglob("shard_*.npz"))
+    assert r.exit_code == 2
+    assert not any(tmp_path.rglob("shard_*.npz"))  # refused before any work
 
 
 def test_a_tiny_split_with_one_worker_is_written(tmp_path):
