@@ -164,3 +164,20 @@ def test_library_init_takes_a_bare_tensors_file_but_checks_its_values(tiny_data)
     with pytest.raises(InputError, match=r"nan\.safetensors"):
         train("a", tune, data_root=tiny_data, out=tiny_data / "u.safetensors",
               run_dir=tiny_data / "r3")  # fmt: skip
+
+
+@pytest.mark.parametrize("kind", ["missing", "folder", "pipe"])
+def test_init_tensors_refuses_what_is_no_regular_file(tmp_path, kind):
+    """--init from Python: a folder or a named pipe (reading one waits for ever) is refused by
+    name before anything reads it."""
+    import os
+
+    from gdnplan.train.graphdistnet import init_tensors
+
+    path = tmp_path / "w.safetensors"
+    if kind == "folder":
+        path.mkdir()
+    elif kind == "pipe":
+        os.mkfifo(path)
+    with pytest.raises(InputError, match="not a regular file"):
+        init_tensors(path)

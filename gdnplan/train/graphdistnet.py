@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..assets import is_file
 from ..data import DATA_DIR, Dataset, concat, env_robot, load, split_dir
 from ..errors import InputError
 from ..metrics import roc_auc, sha256_prefix, used_cosine_distances
@@ -59,8 +60,8 @@ def init_tensors(path: Path) -> dict[str, torch.Tensor]:
     from ..models.outputs import check_magnitudes
 
     path = Path(path)
-    if not path.exists():
-        raise InputError(f"--init: {path} does not exist")
+    if not is_file(path, "--init"):  # a folder, a pipe (reading it would wait for ever)
+        raise InputError(f"--init: {path} does not exist or is not a regular file")
     # a bare tensors file (a hand-made warm start) has no card to check; a pair's card must fit
     model = read_card(path, "--init").get("model") if card_path(path).exists() else "graphdistnet"
     if model != "graphdistnet":
